@@ -1,0 +1,15 @@
+"""One error type for every bad input: it names the file, the line and the field."""
+
+
+class InputError(ValueError):
+    """Bad user input.
+
+    ``path`` is the file, ``line`` the 1-based line number (``None`` when the problem is
+    not tied to one line, e.g. a missing file), ``field`` the name of what was expected
+    (a deck field such as ``CDX`` or a scene key path such as ``bodies.barge.effects``).
+    """
+
+    def __init__(self, path, line, field, message):
+        self.path, self.line, self.field, self.message = str(path), line, field, message
+        where = self.path if line is None else f"{self.path}:{line}"
+        super().__init__(f"{where}: {field}: {message}")

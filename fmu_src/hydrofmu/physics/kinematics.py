@@ -1,0 +1,81 @@
+"""Rigid-body kinematics in the hydrofmu conventions.
+
+Frames: global frame earth-fixed, right-handed, z up, origin on the mean free surface.
+Attitude (roll φ, pitch θ, yaw ψ) in rad; body-to-global rotation R = Rz(ψ)·Ry(θ)·Rx(φ).
+Velocities and accelerations are 6-vectors [linear of the reference point; angular],
+both in global axes.  A 6-vector load is [force; moment about the reference point],
+global axes.
+"""
+import numpy as np
+
+
+def rotation(attitude):
+    """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) for attitude (φ, θ, ψ) [rad]."""
+    phi, theta, psi = attitude
+    cf, sf = np.cos(phi), np.sin(phi)
+    ct, st = np.cos(theta), np.sin(theta)
+    cp, sp = np.cos(psi), np.sin(psi)
+    return np.array([
+        [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
+        [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
+        [-st, ct * sf, ct * cf],
+    ])
+
+
+def skew(r):
+    """Matrix [r]× such that [r]×·a = r × a."""
+    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+
+
+def point_velocity(velocity, r_global):
+    """Velocity [m/s] of the point at global offset r from the reference point: v + ω × r."""
+    return velocity[:3] + np.cross(velocity[3:], r_global)
+
+
+def point_acceleration(velocity, acceleration, r_global):
+    """Acceleration of the point at global offset r: a + α × r + ω × (ω × r)."""
+    w = velocity[3:]
+    return acceleration[:3] + np.cross(acceleration[3:], r_global) + np.cross(w, np.cross(w, r_global))
+
+
+def transfer(force, r_global, moment=None):
+    """6-vector load about the reference point of a force [N] (and moment [N·m]) acting
+    at global offset r: [F; r × F + M]."""
+    m = np.cross(r_global, force)
+    if moment is not None:
+        m = m + moment
+    return np.concatenate([force, m])
+
+
+def to_global(load_body, rot):
+    """Rotate a 6-vector load given in body axes to global axes."""
+    return np.concatenate([rot @ load_body[:3], rot @ load_body[3:]])
+
+
+def to_body(vec6, rot):
+    """Express a global 6-vector (velocity or load) in body axes."""
+    return np.concatenate([rot.T @ vec6[:3], rot.T @ vec6[3:]])
+
+
+def point_mass_matrix(mass3, r_global):
+    """6×6 mass matrix about the reference point of a point mass at global offset r.
+
+    ``mass3`` is the 3×3 translational mass of the point in global axes (m·I for a
+    plain mass, R·diag(AMX, AMY, AMZ)·Rᵀ for directional added mass).  With a = a_ref +
+    α × r (linear part), the load on the body is −M6·[a_ref; α] where
+    M6 = [[M, −M·[r]×], [[r]×·M, −[r]×·M·[r]×]].
+    """
+    s = skew(r_global)
+    return np.block([[mass3, -mass3 @ s], [s @ mass3, -s @ mass3 @ s]])
+
+
+def current_velocity(speed, direction_deg):
+    """Global current velocity [m/s] for a speed and a 'going to' direction in degrees,
+    counter-clockwise from global +x (horizontal, uniform)."""
+    d = np.radians(direction_deg)
+    return np.array([speed * np.cos(d), speed * np.sin(d), 0.0])
+
+
+def quad(x):
+    """x·|x|: the quadratic term that keeps the sign of x."""
+    return x * np.abs(x)

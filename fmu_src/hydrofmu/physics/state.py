@@ -1,0 +1,52 @@
+"""Inputs every load kernel sees: the body's motion and the environment.
+
+Load kernels ("effects") follow one protocol so the FMU wrapper can hold any mix:
+
+    name: str                 # effect name, used for the `<name>.force` output
+    uses_current: bool        # needs Env.current
+    uses_acceleration: bool   # has acceleration loads (mass, added mass)
+    load(motion, env) -> (6,) # [force N; moment N·m about the reference point], global
+                              # axes, WITHOUT the acceleration loads
+    mass_matrix(motion) -> (6, 6)
+                              # mass contribution M about the reference point, global
+                              # axes; the acceleration load is −M·motion.acceleration
+                              # (applied only in `explicit` mode, else exported)
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .kinematics import current_velocity, rotation
+
+
+@dataclass
+class Motion:
+    """Motion of a body's reference point.
+
+    position [m] global; attitude (φ, θ, ψ) [rad]; velocity [m/s, rad/s] and
+    acceleration [m/s², rad/s²] as 6-vectors in global axes.
+    """
+    position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    attitude: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    acceleration: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+    @property
+    def rot(self):
+        """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ)."""
+        return rotation(self.attitude)
+
+
+@dataclass
+class Env:
+    """Water density ρ [kg/m³], gravity g [m/s²], uniform current: speed [m/s] and
+    'going to' direction [deg, counter-clockwise from global +x]."""
+    rho: float = 1025.0
+    g: float = 9.81
+    current_speed: float = 0.0
+    current_direction: float = 0.0
+
+    @property
+    def current(self):
+        """Global current velocity vector [m/s]."""
+        return current_velocity(self.current_speed, self.current_direction)
