@@ -1,0 +1,110 @@
+"""Command line: ``hydrofmu build | run | validate | demo`` (a thin layer over the library)."""
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .errors import InputError
+
+DEFAULT_OUT = Path("build") / "fmus"
+DEMO_SCENE = "moored_barge"
+
+
+def scenes_in(paths, models="models"):
+    """Scene files named on the command line, or every *.toml in models/."""
+    if paths:
+        return [Path(p) for p in paths]
+    found = sorted(Path(models).glob("*.toml"))
+    if not found:
+        raise InputError(models, None, "models", "no scene files (*.toml) found")
+    return found
+
+
+def build(paths, outdir=DEFAULT_OUT, log=print):
+    """Validate every scene first, then build each one; returns {scene name: folder}."""
+    from .fmi.build import build_scene
+    from .scene import load_scene
+
+    scenes = [load_scene(p) for p in paths]  # all validated before anything is written
+    return {s.name: build_scene(s, outdir, log=log) for s in scenes}
+
+
+def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
+    """Run a built scene folder with fmpy (our master) or libcosim; write CSV/PNG."""
+    if engine == "libcosim":
+        from .cosim.libcosim import run
+        kw.pop("algorithm", None)
+    else:
+        from .cosim.master import run
+    result = run(folder, **kw)
+    if csv:
+        result.to_csv(csv)
+    if png:
+        from .cosim.report import plot
+        plot(result, json.loads((Path(folder) / "manifest.json").read_text()), png)
+    return result
+
+
+def validate(paths):
+    """fmpy's validation of FMU files (or of every FMU in folders); returns problem count."""
+    from fmpy.validation import validate_fmu
+    fmus = [f for p in map(Path, paths) for f in (sorted(p.rglob("*.fmu")) if p.is_dir() else [p])]
+    problems = 0
+    for fmu in fmus:
+        found = validate_fmu(str(fmu))
+        problems += len(found)
+        print(f"{fmu.name}: {'ok' if not found else f'{len(found)} problem(s)'}")
+        for p in found:
+            print(f"  {p}")
+    print(f"{len(fmus)} FMU(s), {problems} problem(s)")
+    return problems
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="hydrofmu", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("build", help="build the FMUs of scenes (default: every scene in models/)")
+    b.add_argument("scenes", nargs="*")
+    b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
+    r = sub.add_parser("run", help="run a scene (a .toml is built first) or a built scene folder")
+    r.add_argument("scene")
+    r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
+    r.add_argument("--engine", choices=("fmpy", "libcosim"), default="fmpy")
+    r.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"))
+    r.add_argument("--step", type=float)
+    r.add_argument("--stop", type=float)
+    r.add_argument("--csv", type=Path)
+    r.add_argument("--png", type=Path)
+    v = sub.add_parser("validate", help="fmpy validation of built FMUs")
+    v.add_argument("paths", nargs="*", default=[str(DEFAULT_OUT)])
+    d = sub.add_parser("demo", help="build every scene in models/, run the demo scene, write CSV and PNG")
+    d.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
+    d.add_argument("--scene", default=DEMO_SCENE)
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "build":
+            build(scenes_in(args.scenes), args.out)
+        elif args.command == "validate":
+            return 1 if validate(args.paths) else 0
+        elif args.command == "run":
+            folder = Path(args.scene)
+            if folder.suffix == ".toml":
+                folder = next(iter(build([folder], args.out).values()))
+            result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
+                                algorithm=args.algorithm)
+            print(f"ran {folder.name}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm})")
+        elif args.command == "demo":
+            folders = build(scenes_in([]), args.out)
+            folder = folders[args.scene]
+            csv, png = args.out / f"{args.scene}.csv", args.out / f"{args.scene}.png"
+            result = run_folder(folder, "fmpy", csv, png)
+            print(f"ran {args.scene}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm})")
+            print(f"wrote {csv} and {png}")
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

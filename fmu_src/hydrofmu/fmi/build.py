@@ -1,0 +1,211 @@
+"""Build the FMUs of a scene: one load FMU per floating body, holding only the effects the
+scene gives it, plus one dynamics-partner FMU per body; a manifest (instances,
+connections, run settings) for our masters and an OspSystemStructure.xml for libcosim.
+
+Each FMU is self-contained: its resources carry a copy of the hydrofmu runtime under a
+content-hashed name (two FMUs of different builds in one process never share code by
+accident), the pythonfmu runtime and its JSON configuration; the host needs only numpy.
+Everything is built in a temporary folder and moved into place at the end, so a failed
+build leaves nothing half-written.
+"""
+import hashlib
+import importlib
+import json
+import shutil
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+from xml.dom import minidom
+
+import numpy as np
+
+from . import model_description
+from .slave import CONFIG
+from ..physics.loads import BodyLoads, make_effect
+from ..physics.state import Motion
+
+PACKAGE = Path(__file__).resolve().parents[1]
+
+
+def runtime_name():
+    """'hydrofmu_rt_<hash>': the package copy's name, from the hash of its sources."""
+    h = hashlib.sha256()
+    for f in sorted(PACKAGE.rglob("*.py")):
+        h.update(f.relative_to(PACKAGE).as_posix().encode())
+        h.update(f.read_bytes())
+    return f"hydrofmu_rt_{h.hexdigest()[:10]}"
+
+
+SCRIPT = '''"""hydrofmu FMU {model_id}: {description}"""
+import ctypes
+
+from {runtime}.fmi.slave import {slave}
+
+
+class {model_id}({slave}):
+    def __init__(self, **kwargs):
+        # pythonfmu 0.7's loader drops one reference to this module's globals at every
+        # instantiation (PythonFMU issue #228): give it back, or a second instance fails.
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
+        super().__init__(**kwargs)
+'''
+
+
+def body_loads(scene, body):
+    explicit = body.accel_mode == "explicit"
+    return BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects], explicit)
+
+
+def initial_motion(body):
+    return Motion(np.array(body.position, float), np.array(body.attitude, float))
+
+
+def fmu_specs(scene):
+    """What to build: one dict per FMU instance, in Gauss–Seidel order (loads first, so
+    that every FMU steps from t_k with inputs that are values at t_k)."""
+    env = {"rho": scene.rho, "g": scene.g, "current_speed": scene.current_speed,
+           "current_direction": scene.current_direction}
+    loads_specs, dyn_specs = [], []
+    for body in scene.bodies.values():
+        loads = body_loads(scene, body)
+        exported = (np.zeros((6, 6)) if body.accel_mode == "explicit"
+                    else loads.mass_matrix(initial_motion(body)))
+        dyn_specs.append({
+            "instance": f"{body.name}_dynamics", "model_id": f"{scene.name}_{body.name}_dynamics",
+            "slave": "DynamicsSlave", "kind": "dynamics", "body": body.name,
+            "config": {
+                "description": f"6-DOF rigid-body dynamics of '{body.name}' (scene {scene.name})",
+                "mass": body.mass, "inertia": body.inertia, "cog": body.cog,
+                "stiffness": body.stiffness, "damping": body.damping,
+                "position": body.position, "attitude": body.attitude, "velocity": [0.0] * 6,
+                "substep": scene.run["substep"], "load_sources": [""],
+                "added_mass": exported.tolist(),
+            },
+        })
+        loads_specs.append({
+            "instance": body.name, "model_id": f"{scene.name}_{body.name}",
+            "slave": "LoadSlave", "kind": "load", "body": body.name,
+            "config": {
+                "description": f"hydrodynamic loads on '{body.name}' (scene {scene.name}): "
+                               + ", ".join(f"{e.name} ({e.type})" for e in body.effects),
+                "body": body.name, "position": body.position, "attitude": body.attitude,
+                "accel_mode": body.accel_mode,
+                "effects": [{"type": e.type, "name": e.name, "data": e.data} for e in body.effects],
+                **env,
+            },
+        })
+    return loads_specs + dyn_specs
+
+
+def build_fmu(spec, workdir, runtime, shim=True):
+    """Build one FMU from a spec into ``workdir``; returns (fmu path, slave introspection)."""
+    from pythonfmu.builder import FmuBuilder
+
+    model_id = spec["model_id"]
+    stage = workdir / "stage" / model_id
+    stage.mkdir(parents=True)
+    rt = stage / runtime
+    shutil.copytree(PACKAGE, rt, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "*.c", "*.so"))
+    (stage / CONFIG).write_text(json.dumps(spec["config"]))
+    script = stage / f"{model_id}.py"
+    script.write_text(SCRIPT.format(model_id=model_id, runtime=runtime, slave=spec["slave"],
+                                    description=spec["config"]["description"]))
+    saved_path = list(sys.path)
+    try:
+        fmu = FmuBuilder.build_FMU(script, dest=workdir / "fmus", project_files=[rt, stage / CONFIG],
+                                   canGetAndSetFMUstate=True)
+        slave = getattr(importlib.import_module(model_id), model_id)(
+            instance_name="introspect", resources=str(stage))
+    finally:
+        sys.path[:] = saved_path
+        sys.modules.pop(model_id, None)  # a later load of the FMU must import its own copy
+    rewrite_model_description(fmu, slave)
+    if shim:
+        from .shim import install_shim
+        install_shim(fmu)
+    return Path(fmu), slave
+
+
+def rewrite_model_description(fmu, slave):
+    """Replace modelDescription.xml in the FMU zip (via a temporary copy)."""
+    tmp = Path(str(fmu) + ".tmp")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                data = model_description.complete(data, slave.units, slave.dependencies)
+            dst.writestr(item, data)
+    tmp.replace(fmu)
+
+
+def connections(specs, slaves):
+    """Motion outputs of each body's dynamics → its load FMU's motion inputs (by name),
+    load outputs → dynamics load inputs."""
+    names = {s["instance"]: {v.name for v in slaves[s["instance"]].vars.values()} for s in specs}
+    conns = []
+    for s in specs:
+        if s["kind"] != "load":
+            continue
+        dyn = f"{s['body']}_dynamics"
+        for group, n in (("position", 3), ("attitude", 3), ("velocity", 6), ("acceleration", 6)):
+            for i in range(1, n + 1):
+                var = f"{group}[{i}]"
+                if var in names[s["instance"]]:
+                    conns.append([dyn, var, s["instance"], var])
+        for i in range(1, 7):
+            conns.append([s["instance"], f"force[{i}]", dyn, f"force[{i}]"])
+    return conns
+
+
+def osp_system_structure(scene, specs, conns):
+    """OspSystemStructure.xml text: libcosim's description of the same system."""
+    ns = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
+    root = ET.Element("OspSystemStructure", xmlns=ns, version="0.1")
+    ET.SubElement(root, "StartTime").text = "0.0"
+    ET.SubElement(root, "BaseStepSize").text = repr(scene.run["step"])
+    ET.SubElement(root, "Algorithm").text = "fixedStep"
+    sims = ET.SubElement(root, "Simulators")
+    for s in specs:
+        ET.SubElement(sims, "Simulator", name=s["instance"], source=f"{s['model_id']}.fmu")
+    cons = ET.SubElement(root, "Connections")
+    for src, svar, dst, dvar in conns:
+        vc = ET.SubElement(cons, "VariableConnection")
+        ET.SubElement(vc, "Variable", simulator=src, name=svar)
+        ET.SubElement(vc, "Variable", simulator=dst, name=dvar)
+    return minidom.parseString(ET.tostring(root, encoding="unicode")).toprettyxml(indent="  ")
+
+
+def build_scene(scene, outdir, shim=True, log=print):
+    """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
+    The folder is replaced only when the whole build succeeded."""
+    outdir = Path(outdir)
+    target = outdir / scene.name
+    specs = fmu_specs(scene)
+    runtime = runtime_name()
+    outdir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f".{scene.name}-", dir=outdir) as tmp:
+        work = Path(tmp)
+        slaves = {}
+        for spec in specs:
+            fmu, slaves[spec["instance"]] = build_fmu(spec, work, runtime, shim)
+            log(f"built {fmu.name}")
+        conns = connections(specs, slaves)
+        result = work / "fmus"
+        manifest = {
+            "scene": scene.name, "source": str(scene.path), "run": scene.run,
+            "instances": {s["instance"]: {"fmu": f"{s['model_id']}.fmu", "kind": s["kind"], "body": s["body"]}
+                          for s in specs},
+            "order": [s["instance"] for s in specs],
+            "connections": conns,
+        }
+        (result / "manifest.json").write_text(json.dumps(manifest, indent=2))
+        (result / "OspSystemStructure.xml").write_text(osp_system_structure(scene, specs, conns))
+        old = outdir / f".{scene.name}.old"
+        if target.exists():
+            shutil.rmtree(old, ignore_errors=True)
+            target.rename(old)
+        result.rename(target)
+        shutil.rmtree(old, ignore_errors=True)
+    return target

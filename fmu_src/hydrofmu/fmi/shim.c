@@ -1,0 +1,208 @@
+/*
+ * FMI 2.0 co-simulation forwarding shim for pythonfmu FMUs.
+ *
+ * This library is installed as binaries/linux64/<id>.so.  It loads the original
+ * pythonfmu binary stored beside it as <id>_pythonfmu.so and forwards every FMI
+ * call unchanged, with one exception: fmi2DoStep's fmi2Discard becomes
+ * fmi2Error.  pythonfmu maps a slave's `do_step -> False` to Discard, but
+ * hydrofmu slaves only return False on bad input and never complete a partial
+ * step, so Error is the status the FMI standard asks for.
+ *
+ * The FMI types are declared here (ABI-compatible with the standard headers)
+ * so the shim builds with nothing but a C compiler and libdl.
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <pthread.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+/* ---- FMI 2.0 types (same layout as fmi2TypesPlatform.h / fmi2FunctionTypes.h) ---- */
+typedef void *fmi2Component;
+typedef void *fmi2ComponentEnvironment;
+typedef void *fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef double fmi2Real;
+typedef int fmi2Integer;
+typedef int fmi2Boolean;
+typedef char fmi2Char;
+typedef const fmi2Char *fmi2String;
+typedef char fmi2Byte;
+
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
+typedef enum {
+    fmi2DoStepStatus, fmi2PendingStatus, fmi2LastSuccessfulTime, fmi2Terminated
+} fmi2StatusKind;
+
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status,
+                                   fmi2String, fmi2String, ...);
+typedef void *(*fmi2CallbackAllocateMemory)(size_t, size_t);
+typedef void (*fmi2CallbackFreeMemory)(void *);
+typedef void (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status);
+
+typedef struct {
+    const fmi2CallbackLogger logger;
+    const fmi2CallbackAllocateMemory allocateMemory;
+    const fmi2CallbackFreeMemory freeMemory;
+    const fmi2StepFinished stepFinished;
+    const fmi2ComponentEnvironment componentEnvironment;
+} fmi2CallbackFunctions;
+
+#define EXPORT __attribute__((visibility("default")))
+typedef const fmi2ValueReference *VRs;
+
+/*
+ * Every forwarded function that returns fmi2Status, as
+ * X(name, parameter list, argument list).  One line per FMI function; the
+ * macros below expand it into the pointer table, the symbol lookup and the
+ * exported forwarders.
+ */
+#define FMI_STATUS_FUNCS(X) \
+    X(SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]), (c, on, n, cat)) \
+    X(SetupExperiment, (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef, fmi2Real t1), (c, tolDef, tol, t0, stopDef, t1)) \
+    X(EnterInitializationMode, (fmi2Component c), (c)) \
+    X(ExitInitializationMode, (fmi2Component c), (c)) \
+    X(Terminate, (fmi2Component c), (c)) \
+    X(Reset, (fmi2Component c), (c)) \
+    X(GetReal, (fmi2Component c, VRs vr, size_t n, fmi2Real v[]), (c, vr, n, v)) \
+    X(GetInteger, (fmi2Component c, VRs vr, size_t n, fmi2Integer v[]), (c, vr, n, v)) \
+    X(GetBoolean, (fmi2Component c, VRs vr, size_t n, fmi2Boolean v[]), (c, vr, n, v)) \
+    X(GetString, (fmi2Component c, VRs vr, size_t n, fmi2String v[]), (c, vr, n, v)) \
+    X(SetReal, (fmi2Component c, VRs vr, size_t n, const fmi2Real v[]), (c, vr, n, v)) \
+    X(SetInteger, (fmi2Component c, VRs vr, size_t n, const fmi2Integer v[]), (c, vr, n, v)) \
+    X(SetBoolean, (fmi2Component c, VRs vr, size_t n, const fmi2Boolean v[]), (c, vr, n, v)) \
+    X(SetString, (fmi2Component c, VRs vr, size_t n, const fmi2String v[]), (c, vr, n, v)) \
+    X(GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s)) \
+    X(SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s)) \
+    X(FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s)) \
+    X(SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *size), (c, s, size)) \
+    X(SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t size), (c, s, b, size)) \
+    X(DeSerializeFMUstate, (fmi2Component c, const fmi2Byte b[], size_t size, fmi2FMUstate *s), (c, b, size, s)) \
+    X(GetDirectionalDerivative, (fmi2Component c, VRs unk, size_t nu, VRs kn, size_t nk, const fmi2Real dv[], fmi2Real df[]), (c, unk, nu, kn, nk, dv, df)) \
+    X(SetRealInputDerivatives, (fmi2Component c, VRs vr, size_t n, const fmi2Integer ord[], const fmi2Real v[]), (c, vr, n, ord, v)) \
+    X(GetRealOutputDerivatives, (fmi2Component c, VRs vr, size_t n, const fmi2Integer ord[], fmi2Real v[]), (c, vr, n, ord, v)) \
+    X(CancelStep, (fmi2Component c), (c)) \
+    X(GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v)) \
+    X(GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v)) \
+    X(GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v)) \
+    X(GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v)) \
+    X(GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))
+
+/* Functions with their own return type or behaviour, written out below. */
+#define FMI_OTHER_FUNCS(X) \
+    X(const char *, GetTypesPlatform, (void)) \
+    X(const char *, GetVersion, (void)) \
+    X(fmi2Component, Instantiate, (fmi2String name, fmi2Type type, fmi2String guid, fmi2String res, const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean logging)) \
+    X(void, FreeInstance, (fmi2Component c)) \
+    X(fmi2Status, DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior))
+
+/* Table of pointers into the inner library, one typed member per function. */
+static struct {
+#define STATUS_MEMBER(name, params, args) fmi2Status(*name) params;
+#define OTHER_MEMBER(ret, name, params) ret(*name) params;
+    FMI_STATUS_FUNCS(STATUS_MEMBER)
+    FMI_OTHER_FUNCS(OTHER_MEMBER)
+#undef STATUS_MEMBER
+#undef OTHER_MEMBER
+} inner;
+
+static void *inner_handle;
+static int inner_ok;
+static char inner_err[8192]; /* room for a full path plus dlerror() text */
+static pthread_once_t inner_once = PTHREAD_ONCE_INIT;
+
+/* Path of the inner library: this file's path with ".so" replaced by "_pythonfmu.so". */
+static int inner_path(char *out, size_t size) {
+    Dl_info info;
+    /* any object inside this library will do; a data address avoids a function-pointer cast */
+    if (!dladdr(&inner_once, &info) || !info.dli_fname) {
+        snprintf(inner_err, sizeof inner_err, "cannot find the shim's own path (dladdr failed)");
+        return 0;
+    }
+    const char *self = info.dli_fname;
+    size_t n = strlen(self);
+    if (n >= 3 && strcmp(self + n - 3, ".so") == 0) n -= 3;
+    if (snprintf(out, size, "%.*s_pythonfmu.so", (int)n, self) >= (int)size) {
+        snprintf(inner_err, sizeof inner_err, "path too long: %s", self);
+        return 0;
+    }
+    return 1;
+}
+
+static void load_inner(void) {
+    char path[4096];
+    if (!inner_path(path, sizeof path)) return;
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *e = dlerror();
+        snprintf(inner_err, sizeof inner_err, "cannot load %s: %s", path, e ? e : "unknown error");
+        return;
+    }
+    /* Resolve all symbols; any one missing means the inner library is unusable. */
+#define RESOLVE(name)                                                                     \
+    *(void **)&inner.name = dlsym(h, "fmi2" #name);                                       \
+    if (!inner.name) {                                                                    \
+        snprintf(inner_err, sizeof inner_err, "%s does not export fmi2" #name, path);     \
+        dlclose(h);                                                                       \
+        memset(&inner, 0, sizeof inner);                                                  \
+        return;                                                                           \
+    }
+#define RESOLVE_STATUS(name, params, args) RESOLVE(name)
+#define RESOLVE_OTHER(ret, name, params) RESOLVE(name)
+    FMI_STATUS_FUNCS(RESOLVE_STATUS)
+    FMI_OTHER_FUNCS(RESOLVE_OTHER)
+#undef RESOLVE_STATUS
+#undef RESOLVE_OTHER
+#undef RESOLVE
+    inner_handle = h;
+    inner_ok = 1;
+}
+
+static int ready(void) {
+    pthread_once(&inner_once, load_inner);
+    return inner_ok;
+}
+
+/* Unload the inner library together with the shim, as the host would have unloaded it. */
+__attribute__((destructor)) static void unload_inner(void) {
+    if (inner_handle) dlclose(inner_handle);
+    inner_handle = NULL;
+    inner_ok = 0;
+}
+
+/* ---- plain forwarders ---- */
+#define FORWARD(name, params, args) \
+    EXPORT fmi2Status fmi2##name params { return ready() ? inner.name args : fmi2Error; }
+FMI_STATUS_FUNCS(FORWARD)
+#undef FORWARD
+
+/* ---- the rest ---- */
+EXPORT const char *fmi2GetTypesPlatform(void) {
+    return ready() ? inner.GetTypesPlatform() : "default";
+}
+
+EXPORT const char *fmi2GetVersion(void) {
+    return ready() ? inner.GetVersion() : "2.0";
+}
+
+EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
+                                     fmi2String res, const fmi2CallbackFunctions *cb,
+                                     fmi2Boolean visible, fmi2Boolean logging) {
+    if (ready()) return inner.Instantiate(name, type, guid, res, cb, visible, logging);
+    if (cb && cb->logger)
+        cb->logger(cb->componentEnvironment, name ? name : "", fmi2Error, "logStatusError",
+                   "hydrofmu shim: %s", inner_err);
+    return NULL;
+}
+
+EXPORT void fmi2FreeInstance(fmi2Component c) {
+    if (ready()) inner.FreeInstance(c);
+}
+
+EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior) {
+    if (!ready()) return fmi2Error;
+    fmi2Status s = inner.DoStep(c, t, h, noPrior);
+    return s == fmi2Discard ? fmi2Error : s;
+}

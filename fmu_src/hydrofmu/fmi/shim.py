@@ -1,0 +1,160 @@
+"""Install the FMI status shim (shim.c) into a pythonfmu FMU.
+
+pythonfmu maps a slave's ``do_step`` returning False to ``fmi2Discard``; hydrofmu
+slaves return False only on bad input (they never complete a partial step), so the
+shim turns that ``fmi2DoStep`` status into ``fmi2Error`` and forwards everything
+else unchanged.  Layout inside the FMU after ``install_shim``::
+
+    binaries/linux64/<id>.so            the shim (compiled from shim.c)
+    binaries/linux64/<id>_pythonfmu.so  pythonfmu's original binary, loaded by the shim
+
+Linux only: other platforms' binaries are left untouched (they keep pythonfmu's
+Discard mapping).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+SOURCE = Path(__file__).with_name("shim.c")
+FLAGS = ["-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=c99"]
+LIBS = ["-ldl", "-lpthread"]  # after the source: link order matters with --as-needed
+INNER_SUFFIX = "_pythonfmu.so"
+PLATFORM_DIR = "binaries/linux64"
+
+
+def _compiler() -> list[str]:
+    """The C compiler command: $CC if set, else `cc`, else `gcc`."""
+    env = os.environ.get("CC")
+    if env and shutil.which(shlex.split(env)[0]):
+        return shlex.split(env)
+    for name in ("cc", "gcc"):
+        path = shutil.which(name)
+        if path:
+            return [path]
+    raise RuntimeError(
+        "hydrofmu needs a C compiler to build its FMI shim, but neither $CC, `cc` nor `gcc` "
+        "was found on PATH; install one (e.g. `apt-get install gcc`)"
+    )
+
+
+def _cache_dir() -> Path:
+    """Where compiled shims are kept: $HYDROFMU_CACHE, else $XDG_CACHE_HOME/hydrofmu, else ~/.cache/hydrofmu."""
+    root = os.environ.get("HYDROFMU_CACHE")
+    if root:
+        return Path(root)
+    xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(xdg) / "hydrofmu"
+
+
+def _cached_shim() -> Path:
+    """Compile shim.c once per source/flags hash and return the cached library."""
+    if not sys.platform.startswith("linux"):
+        raise RuntimeError(f"the hydrofmu FMI shim is built for Linux only, not {sys.platform}")
+    src = SOURCE.read_bytes()
+    key = hashlib.sha256(src + " ".join(FLAGS + LIBS).encode()).hexdigest()[:16]
+    lib = _cache_dir() / f"shim-{key}.so"
+    if lib.is_file():
+        return lib
+    lib.parent.mkdir(parents=True, exist_ok=True)
+    cc = _compiler()
+    # Compile to a private name, then rename: concurrent builds never see a partial file.
+    fd, tmp = tempfile.mkstemp(prefix=lib.stem + ".", suffix=".so.tmp", dir=lib.parent)
+    os.close(fd)
+    try:
+        run = subprocess.run(cc + FLAGS + [str(SOURCE), "-o", tmp] + LIBS,
+                             capture_output=True, text=True)
+        if run.returncode != 0:
+            raise RuntimeError(f"compiling {SOURCE} with {cc[0]} failed:\n{run.stderr.strip()}")
+        os.replace(tmp, lib)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return lib
+
+
+def compile_shim(out_path) -> Path:
+    """Write the compiled shim library to ``out_path`` and return it as a Path.
+
+    The compilation itself is cached (keyed by the hash of shim.c and the flags), so
+    building many FMUs compiles once.  Raises RuntimeError when no C compiler is found
+    or the compilation fails.
+    """
+    out = Path(out_path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(_cached_shim(), out)
+    os.chmod(out, 0o755)
+    return out
+
+
+def _model_identifier(zin: zipfile.ZipFile, fmu: Path) -> str:
+    """CoSimulation/@modelIdentifier from the FMU's modelDescription.xml."""
+    try:
+        root = ET.fromstring(zin.read("modelDescription.xml"))
+    except KeyError:
+        raise ValueError(f"{fmu}: no modelDescription.xml in the FMU") from None
+    cs = root.find("CoSimulation")
+    mid = cs.get("modelIdentifier") if cs is not None else None
+    if not mid:
+        raise ValueError(f"{fmu}: modelDescription.xml has no CoSimulation/@modelIdentifier")
+    return mid
+
+
+def _entry(name: str, like: zipfile.ZipInfo | None = None) -> zipfile.ZipInfo:
+    """A zip entry called ``name``: a copy of ``like``'s metadata, or a fresh executable file."""
+    if like is not None:
+        info = zipfile.ZipInfo(name, date_time=like.date_time)
+        info.compress_type, info.external_attr = like.compress_type, like.external_attr
+        info.create_system = like.create_system
+    else:
+        info = zipfile.ZipInfo(name, date_time=time.localtime()[:6])
+        info.compress_type = zipfile.ZIP_DEFLATED
+        info.external_attr = (0o100755 & 0xFFFF) << 16  # regular file, rwxr-xr-x
+        info.create_system = 3  # Unix, so the mode bits are honoured
+    return info
+
+
+def install_shim(fmu_path) -> Path:
+    """Put the shim into the FMU at ``fmu_path`` (rewritten in place) and return the path.
+
+    ``binaries/linux64/<id>.so`` moves to ``binaries/linux64/<id>_pythonfmu.so`` and the
+    shim takes its place; every other entry is copied unchanged.  Running it again on a
+    shimmed FMU only refreshes the shim.  The new zip is written to a temporary file
+    beside the FMU and swapped in at the end, so a failure leaves the FMU as it was.
+    """
+    fmu = Path(fmu_path)
+    shim = _cached_shim().read_bytes()
+    fd, tmp = tempfile.mkstemp(prefix=fmu.name + ".", suffix=".tmp", dir=fmu.parent)
+    os.close(fd)
+    try:
+        with zipfile.ZipFile(fmu) as zin, zipfile.ZipFile(tmp, "w") as zout:
+            mid = _model_identifier(zin, fmu)
+            outer = f"{PLATFORM_DIR}/{mid}.so"
+            inner = f"{PLATFORM_DIR}/{mid}{INNER_SUFFIX}"
+            names = set(zin.namelist())
+            if outer not in names:
+                raise ValueError(f"{fmu}: no {outer} to wrap (not a Linux pythonfmu FMU?)")
+            shimmed = inner in names  # already installed: keep the inner, refresh the shim
+            for info in zin.infolist():
+                if info.filename == outer:
+                    if not shimmed:
+                        zout.writestr(_entry(inner, info), zin.read(info))
+                    zout.writestr(_entry(outer), shim)
+                else:
+                    zout.writestr(_entry(info.filename, info), zin.read(info))
+        shutil.copymode(fmu, tmp)
+        os.replace(tmp, fmu)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return fmu

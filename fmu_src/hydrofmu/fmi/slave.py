@@ -1,0 +1,279 @@
+"""pythonfmu slaves: the FMI face of the physics kernels.
+
+Every Real of a slave lives in one numpy array indexed by value reference, so
+fmi2GetReal/fmi2SetReal are one fancy-indexing each.  Variables are registered next to
+the state they expose, with their unit and, for outputs, the inputs they depend on
+(the build writes both into modelDescription.xml).
+
+Load outputs are direct feedthrough: setting an input marks the outputs stale, and the
+next fmi2GetReal (or fmi2DoStep) evaluates the kernels with the inputs as they are now.
+Bad input values never raise into the host: the slave logs an error and fmi2DoStep
+returns False, which hydrofmu's binary shim reports as fmi2Error.
+"""
+import json
+from pathlib import Path
+
+import numpy as np
+from pythonfmu import Fmi2Slave, Real
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+from ..physics.loads import BodyLoads, make_effect
+from ..physics.rigid_body import RigidBody
+from ..physics.state import Env, Motion
+
+CONFIG = "hydrofmu.json"
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+LIN_ROT = {
+    "velocity": ["m/s"] * 3 + ["rad/s"] * 3,
+    "acceleration": ["m/s2"] * 3 + ["rad/s2"] * 3,
+    "force": ["N"] * 3 + ["N.m"] * 3,
+}
+MASS_UNITS = [["kg"] * 3 + ["kg.m"] * 3] * 3 + [["kg.m"] * 3 + ["kg.m2"] * 3] * 3
+
+
+class ArraySlave(Fmi2Slave):
+    """Base slave: Reals in one array, units and output dependencies recorded."""
+
+    author = "hydrofmu"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.config = json.loads((Path(self.resources) / CONFIG).read_text())
+        self.description = self.config.get("description")
+        self._start = []        # start values while registering
+        self.units = {}         # variable name -> unit
+        self.dependencies = {}  # output name -> input names
+        self.error = None       # message of a bad input seen since the last step
+
+    # -- registration ------------------------------------------------------------------
+    def add(self, name, causality, unit=None, start=0.0, description=None):
+        vr = len(self._start)
+        self._start.append(float(start))
+        kw = {"causality": causality, "description": description,
+              "getter": lambda: self.values[vr]}
+        if causality in (Fmi2Causality.input, Fmi2Causality.parameter):
+            kw["setter"] = lambda v: self.values.__setitem__(vr, v)
+        if causality == Fmi2Causality.parameter:
+            kw["variability"] = Fmi2Variability.fixed
+        elif causality == Fmi2Causality.calculatedParameter:
+            kw.update(variability=Fmi2Variability.fixed, initial=Fmi2Initial.calculated)
+        self.register_variable(Real(name, **kw), nested=False)
+        if unit:
+            self.units[name] = unit
+        return vr
+
+    def add_vector(self, name, n, causality, units, start=None, description=None):
+        """Register name[1..n]; returns the slice of the value array."""
+        start = np.zeros(n) if start is None else np.asarray(start, dtype=float)
+        units = units if isinstance(units, (list, tuple)) else [units] * n
+        first = len(self._start)
+        for i in range(n):
+            self.add(f"{name}[{i + 1}]", causality, units[i], start[i],
+                     description if i == 0 else None)
+        return slice(first, first + n)
+
+    def finish_registration(self):
+        self.values = np.array(self._start, dtype=float)
+
+    def depends(self, outputs, inputs):
+        names = [self.vars[vr].name for s in inputs for vr in range(s.start, s.stop)]
+        for s in outputs:
+            for vr in range(s.start, s.stop):
+                self.dependencies[self.vars[vr].name] = names
+
+    # -- FMI ---------------------------------------------------------------------------
+    def get_real(self, vrs):
+        if self.stale:
+            self.evaluate()
+        return self.values[vrs].tolist()
+
+    def set_real(self, vrs, values):
+        self.values[vrs] = values
+        self.stale = True
+
+    def check_finite(self, slices):
+        """Record an error naming the first non-finite input; True if all are finite."""
+        for s in slices:
+            block = self.values[s]
+            if not np.all(np.isfinite(block)):
+                vr = s.start + int(np.argmin(np.isfinite(block)))
+                self.error = f"input {self.vars[vr].name} = {self.values[vr]} is not finite"
+                return False
+        return True
+
+    def do_step(self, current_time, step_size):
+        try:
+            if not (step_size > 0 and np.isfinite(step_size)):
+                self.error = f"communication step {step_size} must be positive and finite"
+            if self.stale and self.error is None:
+                self.evaluate()
+            if self.error is None:
+                self.advance(current_time, step_size)
+        except Exception as exc:  # never let a Python exception reach the C host
+            self.error = f"{type(exc).__name__}: {exc}"
+        if self.error is not None:
+            self.log(f"{self.instance_name} at t={current_time}: {self.error}", Fmi2Status.error)
+            self.error = None
+            return False
+        return True
+
+    def evaluate(self):
+        self.stale = False
+
+    def advance(self, t, dt):
+        pass
+
+    # FMU state: the value array plus whatever the slave's physics holds.
+    def _get_fmu_state(self):
+        return {"values": self.values.tolist(), "physics": self.physics_state()}
+
+    def _set_fmu_state(self, state):
+        self.values[:] = state["values"]
+        self.set_physics_state(state["physics"])
+        self.stale = True
+
+    def physics_state(self):
+        return None
+
+    def set_physics_state(self, state):
+        pass
+
+
+class LoadSlave(ArraySlave):
+    """Loads on one floating body: motion in, force out (global axes, about the
+    reference point), one output group per effect plus the total."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        cfg = self.config
+        explicit = cfg["accel_mode"] == "explicit"
+        self.loads = BodyLoads([make_effect(e["type"], e["name"], e["data"]) for e in cfg["effects"]], explicit)
+        In, Out, Par = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
+
+        self.position = self.add_vector("position", 3, In, "m", cfg["position"],
+                                        "reference point position, global axes")
+        self.attitude = self.add_vector("attitude", 3, In, "rad", cfg["attitude"],
+                                        "roll, pitch, yaw; R = Rz(yaw) Ry(pitch) Rx(roll)")
+        self.velocity = self.add_vector("velocity", 6, In, LIN_ROT["velocity"], None,
+                                        "reference point velocity and angular velocity, global axes")
+        motion_inputs = [self.position, self.attitude, self.velocity]
+        self.acceleration = None
+        if explicit and self.loads.uses_acceleration:
+            self.acceleration = self.add_vector("acceleration", 6, In, LIN_ROT["acceleration"], None,
+                                                "reference point acceleration, global axes")
+            motion_inputs.append(self.acceleration)
+        self.current = None
+        if self.loads.uses_current:
+            self.current = slice(len(self._start), len(self._start) + 2)
+            self.add("current.speed", In, "m/s", cfg["current_speed"], "uniform current speed")
+            self.add("current.direction", In, "deg", cfg["current_direction"],
+                     "current 'going to' direction, counter-clockwise from global +x")
+        self.rho = self.add("rho", Par, "kg/m3", cfg["rho"], "water density")
+        self.g = self.add("g", Par, "m/s2", cfg["g"], "acceleration of gravity")
+
+        self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
+                                     "total load on the body, global axes, moments about the reference point")
+        self.effect_force = [self.add_vector(f"{e.name}.force", 6, Out, LIN_ROT["force"], None,
+                                             f"load of effect {e.name}")
+                             for e in self.loads.effects]
+        inputs = motion_inputs + ([self.current] if self.current else [])
+        self.depends([self.force] + self.effect_force, inputs)
+        self.inputs = inputs
+
+        # export mode: the mass contribution of acceleration loads, for the dynamics side
+        self.mass = None
+        if self.loads.uses_acceleration and not explicit:
+            start = self.loads.mass_matrix(self.motion_from(np.array(self._start)))
+            self.mass = slice(len(self._start), len(self._start) + 36)
+            for i in range(6):
+                for j in range(6):
+                    self.add(f"mass_matrix[{i + 1},{j + 1}]", Fmi2Causality.calculatedParameter,
+                             MASS_UNITS[i][j], start[i, j],
+                             "exported added/point mass about the reference point, global axes (row = load dof)"
+                             if i == j == 0 else None)
+        self.finish_registration()
+        self.stale = True
+
+    def motion_from(self, values):
+        acc = values[self.acceleration] if self.acceleration else np.zeros(6)
+        return Motion(values[self.position], values[self.attitude], values[self.velocity], acc)
+
+    def env(self):
+        v = self.values
+        speed, direction = (v[self.current] if self.current else (0.0, 0.0))
+        return Env(v[self.rho], v[self.g], speed, direction)
+
+    def evaluate(self):
+        self.stale = False
+        if not self.check_finite(self.inputs):
+            return
+        per_effect = self.loads.effect_loads(self.motion_from(self.values), self.env())
+        for s, load in zip(self.effect_force, per_effect):
+            self.values[s] = load
+        self.values[self.force] = per_effect.sum(axis=0)
+
+
+class DynamicsSlave(ArraySlave):
+    """6-DOF rigid body (the dynamics partner): load inputs in, motion out."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        cfg = self.config
+        In, Out, Par = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
+        self.load_inputs = [self.add_vector(f"{src}.force" if src else "force", 6, In, LIN_ROT["force"], None,
+                                            f"load from {src or 'the body FMU'}, global axes, about the reference point")
+                            for src in cfg["load_sources"]]
+        added = np.asarray(cfg["added_mass"], dtype=float)
+        self.added_mass = slice(len(self._start), len(self._start) + 36)
+        for i in range(6):
+            for j in range(6):
+                self.add(f"added_mass[{i + 1},{j + 1}]", Par, MASS_UNITS[i][j], added[i, j],
+                         "mass contributions exported by load FMUs, global axes" if i == j == 0 else None)
+        self.position = self.add_vector("position", 3, Out, "m", cfg["position"])
+        self.attitude = self.add_vector("attitude", 3, Out, "rad", cfg["attitude"])
+        self.velocity = self.add_vector("velocity", 6, Out, LIN_ROT["velocity"], cfg["velocity"])
+        self.acceleration = self.add_vector("acceleration", 6, Out, LIN_ROT["acceleration"], None)
+        self.depends([self.position, self.attitude, self.velocity, self.acceleration], [])
+        self.finish_registration()
+        self.body = None
+        self.stale = False
+
+    def exit_initialization_mode(self):
+        cfg = self.config
+        v = self.values
+        self.body = RigidBody(
+            mass=cfg["mass"], inertia=np.asarray(cfg["inertia"]), cog=np.asarray(cfg["cog"]),
+            stiffness=np.asarray(cfg["stiffness"]), damping=np.asarray(cfg["damping"]),
+            added_mass=v[self.added_mass].reshape(6, 6).copy(),
+            position0=v[self.position].copy(), attitude0=v[self.attitude].copy(),
+            velocity0=v[self.velocity].copy(), max_substep=cfg["substep"])
+
+    def total_load(self):
+        return sum(self.values[s] for s in self.load_inputs)
+
+    def advance(self, t, dt):
+        if not self.check_finite(self.load_inputs):
+            return
+        body = self.body
+        body.step(dt, self.total_load())
+        v = self.values
+        v[self.position], v[self.attitude] = body.position, body.attitude
+        v[self.velocity], v[self.acceleration] = body.velocity, body.acceleration
+
+    def physics_state(self):
+        return None if self.body is None else _plain(self.body.state())
+
+    def set_physics_state(self, state):
+        if state is not None:
+            self.body.set_state(state)
+
+
+def _plain(obj):
+    """JSON-able copy (lists instead of arrays) of a nested state."""
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    return obj

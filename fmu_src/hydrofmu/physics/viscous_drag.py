@@ -1,0 +1,50 @@
+"""AQWA-style viscous drag: a 6×6 quadratic damping matrix in body axes.
+
+    w = [Rᵀ·v ; Rᵀ·ω]                    body velocity of the reference point [m/s, rad/s], body axes
+    RELATIVE:  w[0:3] = Rᵀ·(v − u_c)     the current velocity u_c (global, uniform) is subtracted
+    F_body = −V · (w ∘ |w|)              [N; N·m], body axes, moments about the reference point
+    F = [R·F_body[0:3] ; R·F_body[3:6]]  global axes
+
+V_ij [N·s²/m², ...] couples load i with velocity j (AQWA layout, V11 surge … V66 yaw).
+The matrix is taken about the body's reference point: for AQWA data (given at the centre of
+gravity) the scene's reference point should be that centre of gravity.
+"""
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from .kinematics import quad, to_body, to_global
+
+
+@dataclass
+class ViscousDrag:
+    """Viscous drag load kernel (effect protocol of physics.state).
+
+    ``matrix``: 6×6 V matrix, body axes; ``relative``: True for AQWA OPTION=RELATIVE
+    (velocity relative to the current), False for ABSOLUTE.
+    """
+    name: str
+    matrix: np.ndarray
+    relative: bool = False
+    uses_acceleration: ClassVar[bool] = False
+
+    def __post_init__(self):
+        self.matrix = np.array(self.matrix, dtype=float)
+        if self.matrix.shape != (6, 6):
+            raise ValueError(f"viscous drag matrix must be 6×6, got {self.matrix.shape}")
+
+    @property
+    def uses_current(self):
+        return self.relative
+
+    def load(self, motion, env):
+        """[force N; moment N·m about the reference point], global axes."""
+        rot = motion.rot
+        w = to_body(motion.velocity, rot)
+        if self.relative:
+            w[:3] -= rot.T @ env.current
+        return to_global(-(self.matrix @ quad(w)), rot)
+
+    def mass_matrix(self, motion):
+        return np.zeros((6, 6))

@@ -1,0 +1,356 @@
+"""Scene files: which bodies exist, their mass properties, and which effects each one has.
+
+A scene is a TOML file (read with the standard library).  Validation collects every
+problem, each named by the file and the key path (``bodies.barge.effects[1].deck``),
+and raises one InputError listing them all before anything is built.  Effect data
+comes inline or from a vendor deck (path relative to the scene file + the name of the
+body/structure in the deck).  See the README for the full format.
+"""
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+ACCEL_MODES = ("export", "explicit")
+
+
+@dataclass
+class Effect:
+    """One load model on one body: ``type`` (see EFFECT_TYPES), unique ``name`` and the
+    data the kernel needs (plain JSON-able values, decks already read)."""
+    type: str
+    name: str
+    data: dict
+
+
+@dataclass
+class Body:
+    """A floating body.  ``position``/``attitude``: initial pose of the reference point
+    (global, m / rad).  Mass properties are what the dynamics side needs: mass [kg],
+    inertia [kg·m²] about the CoG in body axes, cog [m] in body axes from the reference
+    point, stiffness K and linear damping D (6×6, about the reference point, global)."""
+    name: str
+    position: list
+    attitude: list
+    mass: float
+    inertia: list
+    cog: list
+    stiffness: list
+    damping: list
+    accel_mode: str = "export"
+    effects: list = field(default_factory=list)
+
+
+@dataclass
+class Scene:
+    name: str
+    path: Path
+    rho: float
+    g: float
+    current_speed: float
+    current_direction: float
+    bodies: dict
+    run: dict
+    joints: dict = field(default_factory=dict)
+    couplings: list = field(default_factory=list)
+
+
+class Problems:
+    """Collects validation problems so that one error lists them all."""
+
+    def __init__(self, path):
+        self.path, self.items = Path(path), []
+
+    def add(self, key, message):
+        self.items.append((key, message))
+
+    def raise_if_any(self):
+        if self.items:
+            text = "; ".join(f"{k}: {m}" for k, m in self.items)
+            first = self.items[0][0]
+            raise InputError(self.path, None, first, text if len(self.items) > 1 else self.items[0][1])
+
+    # typed getters: return a value or None after recording the problem
+    def table(self, parent, key, where, required=True):
+        value = parent.get(key)
+        if value is None:
+            if required:
+                self.add(where, "missing table")
+            return {} if not required else None
+        if not isinstance(value, dict):
+            self.add(where, "expected a table")
+            return None
+        return value
+
+    def number(self, parent, key, where, default=None, positive=False, nonneg=False):
+        value = parent.get(key, default)
+        if value is None:
+            self.add(where, "missing value")
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            self.add(where, f"expected a number, found {value!r}")
+            return None
+        if positive and value <= 0:
+            self.add(where, f"must be positive, found {value}")
+            return None
+        if nonneg and value < 0:
+            self.add(where, f"must not be negative, found {value}")
+            return None
+        return float(value)
+
+    def vector(self, parent, key, where, n, default=None):
+        value = parent.get(key, default)
+        if value is None:
+            self.add(where, f"missing {n}-vector")
+            return None
+        arr = self._array(value, where)
+        if arr is None:
+            return None
+        if arr.shape != (n,):
+            self.add(where, f"expected {n} numbers, found shape {list(arr.shape)}")
+            return None
+        return arr.tolist()
+
+    def matrix(self, parent, key, where, n, default=None, diagonal_ok=True):
+        """n×n matrix; a list of n numbers means a diagonal matrix."""
+        value = parent.get(key, default)
+        if value is None:
+            self.add(where, f"missing {n}x{n} matrix")
+            return None
+        arr = self._array(value, where)
+        if arr is None:
+            return None
+        if diagonal_ok and arr.shape == (n,):
+            arr = np.diag(arr)
+        if arr.shape != (n, n):
+            self.add(where, f"expected a {n}x{n} matrix{' or ' + str(n) + ' diagonal values' if diagonal_ok else ''}, "
+                            f"found shape {list(arr.shape)}")
+            return None
+        return arr.tolist()
+
+    def choice(self, parent, key, where, options, default=None):
+        value = parent.get(key, default)
+        if value not in options:
+            self.add(where, f"expected one of {', '.join(map(repr, options))}, found {value!r}")
+            return None
+        return value
+
+    def string(self, parent, key, where, default=None):
+        value = parent.get(key, default)
+        if not isinstance(value, str) or not value:
+            self.add(where, f"expected a non-empty string, found {value!r}")
+            return None
+        return value
+
+    def known_keys(self, table, where, allowed):
+        for key in table:
+            if key not in allowed:
+                self.add(f"{where}.{key}" if where else key,
+                         f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+    def _array(self, value, where):
+        try:
+            arr = np.array(value, dtype=float)
+        except (TypeError, ValueError):
+            self.add(where, "expected numbers (ragged or non-numeric array)")
+            return None
+        if not np.all(np.isfinite(arr)):
+            self.add(where, "contains a non-finite number")
+            return None
+        return arr
+
+
+def identifier(name):
+    """True for names usable in FMU variable names and model identifiers."""
+    return bool(name) and name.replace("_", "a").isalnum() and name[0].isalpha() and name.isascii()
+
+
+# --- effect types: each validator turns the scene table into kernel data ------------
+
+def _deck_path(problems, table, where):
+    deck = problems.string(table, "deck", f"{where}.deck")
+    if deck is None:
+        return None
+    path = (problems.path.parent / deck).resolve()
+    if not path.is_file():
+        problems.add(f"{where}.deck", f"deck file not found: {path}")
+        return None
+    return path
+
+
+def _from_deck(problems, table, where, reader, name_key):
+    """Read a deck and pick the named entry; deck errors are recorded, not raised."""
+    path = _deck_path(problems, table, where)
+    name = problems.string(table, name_key, f"{where}.{name_key}")
+    if path is None or name is None:
+        return None, None
+    try:
+        entries = reader(path)
+    except InputError as exc:
+        problems.add(f"{where}.deck", str(exc))
+        return None, None
+    if name not in entries:
+        problems.add(f"{where}.{name_key}", f"{name!r} is not in {path.name} (it has: {', '.join(entries) or 'none'})")
+        return None, None
+    return entries[name], path
+
+
+def _aqwa_viscous_drag(problems, table, where):
+    from .decks.aqwa import read_viscous_drag
+    if "deck" in table:
+        problems.known_keys(table, where, {"type", "name", "deck", "body"})
+        data, _ = _from_deck(problems, table, where, read_viscous_drag, "body")
+        if data is None:
+            return None
+        return {"matrix": np.asarray(data.matrix).tolist(), "relative": data.option == "RELATIVE"}
+    problems.known_keys(table, where, {"type", "name", "matrix", "option"})
+    matrix = problems.matrix(table, "matrix", f"{where}.matrix", 6)
+    option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
+    if matrix is None or option is None:
+        return None
+    return {"matrix": matrix, "relative": option == "RELATIVE"}
+
+
+def _deeplines_current_polar(problems, table, where):
+    from .decks.deeplines import CurrentPolarData, read_current_polars
+    from .physics.current_polar import expand_polar
+    symmetry = problems.choice(table, "symmetry", f"{where}.symmetry", ("none", "xz", "yz", "xz+yz"), "none")
+    if "deck" in table:
+        problems.known_keys(table, where, {"type", "name", "deck", "structure", "symmetry"})
+        data, _ = _from_deck(problems, table, where, read_current_polars, "structure")
+    else:
+        problems.known_keys(table, where, {"type", "name", "point", "surface", "table", "symmetry"})
+        point = problems.vector(table, "point", f"{where}.point", 3)
+        surface = problems.number(table, "surface", f"{where}.surface", positive=True)
+        raw = table.get("table")
+        arr = problems._array(raw, f"{where}.table") if raw is not None else None
+        if raw is None:
+            problems.add(f"{where}.table", "missing table of [angle, CX, CY, CMZ] rows")
+        elif arr is not None and (arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 2):
+            problems.add(f"{where}.table", f"expected rows of 4 numbers [angle, CX, CY, CMZ], found shape {list(arr.shape)}")
+            arr = None
+        if point is None or surface is None or arr is None:
+            return None
+        data = CurrentPolarData(name=table.get("name", "polar"), xc=point[0], yc=point[1], zc=point[2],
+                                surfc=surface, angles=arr[:, 0], cx=arr[:, 1], cy=arr[:, 2], cmz=arr[:, 3],
+                                path=str(problems.path), line=None)
+    if data is None or symmetry is None:
+        return None
+    try:
+        angles, cx, cy, cmz = expand_polar(data, symmetry)
+    except InputError as exc:
+        problems.add(f"{where}.symmetry", str(exc))
+        return None
+    return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
+            "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
+
+
+# type -> (validator, default effect name)
+EFFECT_TYPES = {
+    "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
+    "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),
+}
+
+BODY_KEYS = {"position", "attitude", "mass", "inertia", "cog", "stiffness", "damping",
+             "acceleration_loads", "effects"}
+RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01}
+
+
+def _body(problems, name, table, where):
+    problems.known_keys(table, where, BODY_KEYS)
+    if not identifier(name):
+        problems.add(where, "body name must start with a letter and hold only letters, digits and '_'")
+    body = Body(
+        name=name,
+        position=problems.vector(table, "position", f"{where}.position", 3, [0.0, 0.0, 0.0]),
+        attitude=problems.vector(table, "attitude", f"{where}.attitude", 3, [0.0, 0.0, 0.0]),
+        mass=problems.number(table, "mass", f"{where}.mass", positive=True),
+        inertia=problems.matrix(table, "inertia", f"{where}.inertia", 3),
+        cog=problems.vector(table, "cog", f"{where}.cog", 3, [0.0, 0.0, 0.0]),
+        stiffness=problems.matrix(table, "stiffness", f"{where}.stiffness", 6, [0.0] * 6),
+        damping=problems.matrix(table, "damping", f"{where}.damping", 6, [0.0] * 6),
+        accel_mode=problems.choice(table, "acceleration_loads", f"{where}.acceleration_loads",
+                                   ACCEL_MODES, "export"),
+    )
+    effects = table.get("effects", [])
+    if not isinstance(effects, list):
+        problems.add(f"{where}.effects", "expected an array of tables ([[bodies.NAME.effects]])")
+        effects = []
+    names = set()
+    for i, eff in enumerate(effects):
+        ew = f"{where}.effects[{i}]"
+        if not isinstance(eff, dict):
+            problems.add(ew, "expected a table")
+            continue
+        etype = eff.get("type")
+        if etype not in EFFECT_TYPES:
+            problems.add(f"{ew}.type", f"unknown effect type {etype!r} (known: {', '.join(EFFECT_TYPES)})")
+            continue
+        validate, default_name = EFFECT_TYPES[etype]
+        ename = eff.get("name", default_name)
+        if not isinstance(ename, str) or not identifier(ename):
+            problems.add(f"{ew}.name", f"effect name must be an identifier, found {ename!r}")
+            continue
+        if ename in names:
+            problems.add(f"{ew}.name", f"duplicate effect name {ename!r} on body {name!r}")
+            continue
+        names.add(ename)
+        data = validate(problems, eff, ew)
+        if data is not None:
+            body.effects.append(Effect(etype, ename, data))
+    return body
+
+
+def load_scene(path):
+    """Read and validate a scene file.  Raises one InputError naming the file and the
+    key path of every problem; returns a Scene whose effect data is ready for kernels."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError(path, None, "file", f"cannot read scene ({exc.strerror})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = getattr(exc, "lineno", None)
+        raise InputError(path, line, "toml", str(exc)) from None
+    p = Problems(path)
+    p.known_keys(doc, "", {"scene", "environment", "run", "bodies", "joints", "couplings"})
+    meta = p.table(doc, "scene", "scene", required=False) or {}
+    p.known_keys(meta, "scene", {"name", "description"})
+    name = meta.get("name", path.stem)
+    if not isinstance(name, str) or not identifier(name):
+        p.add("scene.name", f"scene name must be an identifier, found {name!r}")
+    env = p.table(doc, "environment", "environment", required=False) or {}
+    p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction"})
+    run = p.table(doc, "run", "run", required=False) or {}
+    p.known_keys(run, "run", set(RUN_DEFAULTS))
+    run_cfg = {
+        "step": p.number(run, "step", "run.step", RUN_DEFAULTS["step"], positive=True),
+        "stop": p.number(run, "stop", "run.stop", RUN_DEFAULTS["stop"], positive=True),
+        "algorithm": p.choice(run, "algorithm", "run.algorithm", ("jacobi", "gauss-seidel"),
+                              RUN_DEFAULTS["algorithm"]),
+        "substep": p.number(run, "substep", "run.substep", RUN_DEFAULTS["substep"], positive=True),
+    }
+    bodies_t = p.table(doc, "bodies", "bodies") or {}
+    bodies = {}
+    for bname, btable in bodies_t.items():
+        if not isinstance(btable, dict):
+            p.add(f"bodies.{bname}", "expected a table")
+            continue
+        bodies[bname] = _body(p, bname, btable, f"bodies.{bname}")
+    if not bodies and "bodies" in doc:
+        p.add("bodies", "a scene needs at least one body")
+    scene = Scene(
+        name=name, path=path,
+        rho=p.number(env, "rho", "environment.rho", 1025.0, positive=True),
+        g=p.number(env, "g", "environment.g", 9.81, positive=True),
+        current_speed=p.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),
+        current_direction=p.number(env, "current_direction", "environment.current_direction", 0.0),
+        bodies=bodies, run=run_cfg,
+    )
+    p.raise_if_any()
+    return scene

@@ -1,0 +1,268 @@
+"""The FMI status shim: doStep's Discard becomes Error, everything else is forwarded.
+
+A tiny pythonfmu FMU (y = 2 x; do_step logs an error and returns False on a
+non-finite x) is built once per module, shimmed, and driven through fmpy and
+libcosimpy.
+"""
+
+import math
+import shutil
+import uuid
+import zipfile
+from ctypes import byref
+
+import pytest
+
+pytest.importorskip("pythonfmu")
+fmpy = pytest.importorskip("fmpy")
+from fmpy import extract, read_model_description, simulate_fmu  # noqa: E402
+from fmpy.fmi1 import FMICallException  # noqa: E402
+from fmpy.fmi2 import (  # noqa: E402
+    FMU2Slave,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+    fmi2Error,
+)
+from fmpy.validation import validate_fmu  # noqa: E402
+
+from hydrofmu.fmi import shim  # noqa: E402
+
+try:
+    shim._compiler()
+except RuntimeError:
+    pytest.skip("no C compiler", allow_module_level=True)
+
+# Module and class names must be unique in the process (pythonfmu imports by name).
+# The Py_IncRef works around pythonfmu 0.7 dropping a reference to the module's
+# globals at every instantiation (PythonFMU issue #228).
+SCRIPT = '''
+import ctypes
+import math
+from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+from pythonfmu.enums import Fmi2Status
+
+
+class {cls}(Fmi2Slave):
+    def __init__(self, **kwargs):
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
+        super().__init__(**kwargs)
+        self.x = 0.0
+        self.y = 0.0
+        self.register_variable(Real("x", causality=Fmi2Causality.input))
+        self.register_variable(Real("y", causality=Fmi2Causality.output))
+
+    def do_step(self, current_time, step_size):
+        if not math.isfinite(self.x):
+            self.log("x is not finite", status=Fmi2Status.error)
+            return False
+        self.y = 2.0 * self.x
+        return True
+'''
+
+
+def _build(directory):
+    """Build the doubler FMU in ``directory``; returns the FMU path."""
+    from pythonfmu.builder import FmuBuilder
+
+    tag = uuid.uuid4().hex[:10]
+    script = directory / f"shimdbl_{tag}.py"
+    script.write_text(SCRIPT.format(cls=f"ShimDbl_{tag}"))
+    return FmuBuilder.build_FMU(script, dest=directory)
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory):
+    """(plain FMU, shimmed FMU), same model; the shimmed one is a rewritten copy."""
+    d = tmp_path_factory.mktemp("shimfmu")
+    plain = _build(d)
+    shimmed = d / "shimmed" / plain.name
+    shimmed.parent.mkdir()
+    shutil.copy(plain, shimmed)
+    assert shim.install_shim(shimmed) == shimmed
+    return plain, shimmed
+
+
+def _slave(fmu, name, tmp_path, messages):
+    """An instantiated, initialised FMU2Slave whose log messages go to ``messages``."""
+    md = read_model_description(str(fmu))
+    unzipped = extract(str(fmu), unzipdir=str(tmp_path / name))
+    s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped,
+                  modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+
+    def log(env, inst, status, cat, msg):
+        messages.append((status, msg.decode()))
+
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(log)
+    s.instantiate(callbacks=cb, loggingOn=True)
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    return s, vr
+
+
+def test_layout(fmus):
+    plain, shimmed = fmus
+    mid = read_model_description(str(plain)).coSimulation.modelIdentifier
+    lib = f"binaries/linux64/{mid}.so"
+    with zipfile.ZipFile(plain) as zp, zipfile.ZipFile(shimmed) as zs:
+        orig, names = zp.read(lib), set(zs.namelist())
+        assert names == set(zp.namelist()) | {f"binaries/linux64/{mid}_pythonfmu.so"}
+        assert zs.read(f"binaries/linux64/{mid}_pythonfmu.so") == orig
+        assert zs.read(lib) == shim._cached_shim().read_bytes()
+        # every other entry (resources, win64 dll, XML) is byte-identical
+        for n in zp.namelist():
+            if n != lib:
+                assert zs.read(n) == zp.read(n), n
+
+
+def test_install_twice_refreshes_only(fmus, tmp_path):
+    _, shimmed = fmus
+    again = tmp_path / shimmed.name
+    shutil.copy(shimmed, again)
+    shim.install_shim(again)
+    with zipfile.ZipFile(shimmed) as a, zipfile.ZipFile(again) as b:
+        assert a.namelist() == b.namelist()
+        for n in a.namelist():
+            assert a.read(n) == b.read(n), n
+
+
+def test_install_failure_leaves_fmu_untouched(tmp_path):
+    bad = tmp_path / "bad.fmu"
+    with zipfile.ZipFile(bad, "w") as z:
+        z.writestr("modelDescription.xml", '<fmiModelDescription fmiVersion="2.0"/>')
+    before = bad.read_bytes()
+    with pytest.raises(ValueError, match="modelIdentifier"):
+        shim.install_shim(bad)
+    assert bad.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.fmu"]  # no temp left behind
+
+
+def test_compile_shim_cached_and_no_compiler(tmp_path, monkeypatch):
+    monkeypatch.setenv("HYDROFMU_CACHE", str(tmp_path / "cache"))
+    a = shim.compile_shim(tmp_path / "a" / "shim.so")
+    b = shim.compile_shim(tmp_path / "b.so")
+    assert a.read_bytes() == b.read_bytes()
+    assert len(list((tmp_path / "cache").glob("shim-*.so"))) == 1
+    # a fresh cache with no compiler on PATH: clear error, not a crash
+    monkeypatch.setenv("HYDROFMU_CACHE", str(tmp_path / "cache2"))
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    monkeypatch.delenv("CC", raising=False)
+    with pytest.raises(RuntimeError, match="C compiler"):
+        shim.compile_shim(tmp_path / "c.so")
+
+
+def test_step_nan_is_error_and_instance_survives(fmus, tmp_path):
+    _, shimmed = fmus
+    msgs = []
+    s, vr = _slave(shimmed, "one", tmp_path, msgs)
+    try:
+        assert s.fmi2GetTypesPlatform() == b"default"
+        assert s.fmi2GetVersion() == b"2.0"
+        s.setReal([vr["x"]], [1.25])
+        s.doStep(0.0, 0.1)  # raises on any status but OK/Warning
+        assert s.getReal([vr["y"]]) == [2.5]
+
+        s.setReal([vr["x"]], [math.nan])
+        with pytest.raises(FMICallException, match=r"status 3 \(error\)"):
+            s.doStep(0.1, 0.1)
+        assert (fmi2Error, "x is not finite") in msgs
+
+        s.setReal([vr["x"]], [math.inf])
+        with pytest.raises(FMICallException, match=r"status 3"):
+            s.doStep(0.1, 0.1)
+
+        s.setReal([vr["x"]], [-4.0])  # the instance is alive and steps again
+        s.doStep(0.1, 0.1)
+        assert s.getReal([vr["y"]]) == [-8.0]
+        s.terminate()
+    finally:
+        s.freeInstance()
+
+
+def test_plain_fmu_discards(fmus, tmp_path):
+    """Without the shim pythonfmu reports Discard: the shim is what changes it."""
+    plain, _ = fmus
+    s, vr = _slave(plain, "plain", tmp_path, [])
+    try:
+        s.setReal([vr["x"]], [math.nan])
+        with pytest.raises(FMICallException, match=r"status 2 \(discard\)"):
+            s.doStep(0.0, 0.1)
+    finally:
+        s.freeInstance()
+
+
+def test_two_instances(fmus, tmp_path):
+    _, shimmed = fmus
+    a, vr = _slave(shimmed, "a", tmp_path, [])
+    b, _ = _slave(shimmed, "b", tmp_path, [])
+    try:
+        a.setReal([vr["x"]], [1.0])
+        b.setReal([vr["x"]], [-3.0])
+        a.doStep(0.0, 0.1)
+        b.doStep(0.0, 0.1)
+        assert a.getReal([vr["y"]]) == [2.0]
+        assert b.getReal([vr["y"]]) == [-6.0]
+    finally:
+        a.freeInstance()
+        b.freeInstance()
+
+
+def test_missing_inner_library_fails_instantiate_with_log(fmus, tmp_path):
+    _, shimmed = fmus
+    md = read_model_description(str(shimmed))
+    mid = md.coSimulation.modelIdentifier
+    unzipped = extract(str(shimmed), unzipdir=str(tmp_path / "broken"))
+    (tmp_path / "broken" / "binaries" / "linux64" / f"{mid}_pythonfmu.so").unlink()
+    msgs = []
+    s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=mid, instanceName="x")
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(lambda env, inst, st, cat, msg: msgs.append((st, msg)))
+    from fmpy.logging import addLoggerProxy  # formats the variadic message for ctypes
+
+    addLoggerProxy(byref(cb))
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        s.instantiate(callbacks=cb)
+    assert msgs and msgs[0][0] == fmi2Error
+    assert b"cannot load" in msgs[0][1] and f"{mid}_pythonfmu.so".encode() in msgs[0][1]
+    s.freeLibrary()
+
+
+def test_simulate_fmu(fmus):
+    _, shimmed = fmus
+    res = simulate_fmu(str(shimmed), stop_time=1.0, output_interval=0.1,
+                       start_values={"x": 0.75}, output=["y"])
+    assert len(res) >= 10
+    assert all(y == 1.5 for y in res["y"][1:])  # y is set by the first step
+
+
+def test_validate_no_new_problems(fmus):
+    plain, shimmed = fmus
+    assert set(validate_fmu(str(shimmed))) <= set(validate_fmu(str(plain)))
+
+
+def test_libcosimpy(fmus):
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    _, shimmed = fmus
+    vr = {v.name: v.valueReference for v in read_model_description(str(shimmed)).modelVariables}
+    ex = CosimExecution.from_step_size(step_size=int(0.1e9))
+    a = ex.add_local_slave(CosimLocalSlave(fmu_path=str(shimmed), instance_name="a"))
+    b = ex.add_local_slave(CosimLocalSlave(fmu_path=str(shimmed), instance_name="b"))
+    ex.real_initial_value(a, vr["x"], 0.5)
+    ex.connect_real_variables(a, vr["y"], b, vr["x"])
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    assert ex.simulate_until(target_time=int(1e9))
+    assert obs.last_real_values(a, [vr["y"]]) == [1.0]
+    assert obs.last_real_values(b, [vr["y"]]) == [2.0]  # b.x = a.y = 1
+
+    # a NaN input stops the co-simulation cleanly (doStep error), no crash
+    bad = CosimExecution.from_step_size(step_size=int(0.1e9))
+    c = bad.add_local_slave(CosimLocalSlave(fmu_path=str(shimmed), instance_name="c"))
+    bad.real_initial_value(c, vr["x"], math.nan)
+    assert not bad.simulate_until(target_time=int(1e9))
