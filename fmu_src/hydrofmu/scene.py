@@ -29,12 +29,14 @@ class Effect:
 @dataclass
 class Body:
     """A floating body.  ``position``/``attitude``: initial pose of the reference point
-    (global, m / rad).  Mass properties are what the dynamics side needs: mass [kg],
+    (global, m / rad), which is also the equilibrium the stiffness acts about;
+    ``velocity``: initial velocity (6, global, m/s and rad/s).  Mass properties are what the dynamics side needs: mass [kg],
     inertia [kg·m²] about the CoG in body axes, cog [m] in body axes from the reference
     point, stiffness K and linear damping D (6×6, about the reference point, global)."""
     name: str
     position: list
     attitude: list
+    velocity: list
     mass: float
     inertia: list
     cog: list
@@ -254,7 +256,7 @@ EFFECT_TYPES = {
     "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),
 }
 
-BODY_KEYS = {"position", "attitude", "mass", "inertia", "cog", "stiffness", "damping",
+BODY_KEYS = {"position", "attitude", "velocity", "mass", "inertia", "cog", "stiffness", "damping",
              "acceleration_loads", "effects"}
 RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01}
 
@@ -267,6 +269,7 @@ def _body(problems, name, table, where):
         name=name,
         position=problems.vector(table, "position", f"{where}.position", 3, [0.0, 0.0, 0.0]),
         attitude=problems.vector(table, "attitude", f"{where}.attitude", 3, [0.0, 0.0, 0.0]),
+        velocity=problems.vector(table, "velocity", f"{where}.velocity", 6, [0.0] * 6),
         mass=problems.number(table, "mass", f"{where}.mass", positive=True),
         inertia=problems.matrix(table, "inertia", f"{where}.inertia", 3),
         cog=problems.vector(table, "cog", f"{where}.cog", 3, [0.0, 0.0, 0.0]),

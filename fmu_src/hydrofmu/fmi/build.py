@@ -79,7 +79,7 @@ def fmu_specs(scene):
                 "description": f"6-DOF rigid-body dynamics of '{body.name}' (scene {scene.name})",
                 "mass": body.mass, "inertia": body.inertia, "cog": body.cog,
                 "stiffness": body.stiffness, "damping": body.damping,
-                "position": body.position, "attitude": body.attitude, "velocity": [0.0] * 6,
+                "position": body.position, "attitude": body.attitude, "velocity": body.velocity,
                 "substep": scene.run["substep"], "load_sources": [""],
                 "added_mass": exported.tolist(),
             },

@@ -6,9 +6,12 @@ the FMU only carries JSON.  Acceleration loads follow DESIGN.md's two modes:
 - ``export``: the effect's acceleration loads are not applied; their 6×6 mass
   contribution (about the reference point, global axes, evaluated at the initial pose)
   is published for the dynamics side to add to its mass matrix.
-- ``explicit``: applied as loads, −M·a (+ the velocity-dependent part of a point mass's
-  inertia load where the kernel gives one), with the added-mass stability limit of
-  staggered coupling (diverges when A/M ≳ 1).
+- ``explicit``: applied as loads, −M·a, with the added-mass stability limit of staggered
+  coupling (diverges when A/M ≳ 1).
+
+The velocity-dependent part of a point mass's inertia load (centripetal, −M_p·ω×(ω×r),
+``velocity_load`` where a kernel has one) is not an acceleration load: it is applied in
+both modes, since an exported constant M cannot carry it.
 """
 import numpy as np
 
@@ -50,8 +53,9 @@ class BodyLoads:
         out = np.empty((len(self.effects), 6))
         for i, eff in enumerate(self.effects):
             load = eff.load(motion, env)
-            if self.explicit and eff.uses_acceleration:
-                load = load - eff.mass_matrix(motion) @ motion.acceleration
+            if eff.uses_acceleration:
+                if self.explicit:
+                    load = load - eff.mass_matrix(motion) @ motion.acceleration
                 velocity_load = getattr(eff, "velocity_load", None)
                 if velocity_load is not None:
                     load = load + velocity_load(motion)

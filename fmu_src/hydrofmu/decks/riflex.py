@@ -1,0 +1,143 @@
+"""RIFLEX input: the BODY and CONB component data groups.
+
+Layout, one data group per component (keywords: first four letters of each word, any
+case; lines starting with ' are comments; commas separate like blanks)::
+
+    NEW COMPonent BODY              NEW COMPonent CONB
+    CMPTYP-ID                       CMPTYP-ID
+    AM AE                           AM AE
+    ICOO CDX CDY CDZ AMX AMY AMZ    ICOO CDX CDY CDZ AMX AMY AMZ
+                                    IRX IRY IRZ        (optional line, each defaults to 0)
+
+Units: AM [kg], AE [m³], CD [N/(m/s)²], AMX.. [kg]; ICOO GLOBAL or LOCAL; IRX.. 1 fixed,
+0 free.  Every other data group, and lines before the first group, are skipped.  A line
+starts a data group when it is a NEW line or all its words begin with a letter (RIFLEX
+groups such as ``END`` or ``UNIT NAMES SPECIFICATION``): such a line ends the CONB group
+without its IRX line; any other line left after a BODY or CONB group is an error.
+"""
+from dataclasses import dataclass
+
+from ..errors import InputError
+from ..physics.lumped import LumpedBody, coordinate_code
+from .lines import Cursor, fields, is_keyword, keyword_key, read_lines
+
+HYDRO = ("ICOO", "CDX", "CDY", "CDZ", "AMX", "AMY", "AMZ")
+FREEDOM = ("IRX", "IRY", "IRZ")
+GROUPS = {"BODY": "NEW COMPonent BODY", "CONB": "NEW COMPonent CONB"}
+
+
+@dataclass(frozen=True)
+class _Lumped:
+    name: str                 # CMPTYP-ID
+    am: float                 # mass [kg]
+    ae: float                 # displaced volume [m³]
+    icoo: str                 # 'GLOBAL' or 'LOCAL'
+    cd: tuple                 # (CDX, CDY, CDZ) [N/(m/s)²]
+    added_mass: tuple         # (AMX, AMY, AMZ) [kg]
+    path: str                 # deck file
+    line: int                 # line of the data group identifier
+
+    def lumped(self, offset, name=None):
+        """The component as a LumpedBody at ``offset`` (body axes, m) of a body."""
+        return LumpedBody(name or self.name, offset, self.am, self.ae, self.icoo, self.cd, self.added_mass)
+
+
+@dataclass(frozen=True)
+class BodyData(_Lumped):
+    """NEW COMPonent BODY: lumped mass, volume, drag and added mass at a point."""
+
+
+@dataclass(frozen=True)
+class ConbData(_Lumped):
+    """NEW COMPonent CONB: ball joint; ``codes`` = (IRX, IRY, IRZ), 1 fixed, 0 free."""
+    codes: tuple = (0, 0, 0)
+
+    @property
+    def free(self):
+        """(3,) bools, True where the rotation about that axis is free (code 0)."""
+        return tuple(c == 0 for c in self.codes)
+
+
+def starts_group(line):
+    """True if ``line`` opens a data group: a NEW line or one of words that all begin with a letter."""
+    words = line.words
+    return keyword_key(line.text)[:1] == ("NEW",) or all(w[0].isalpha() for w in words)
+
+
+def read_components(path):
+    """All BODY and CONB components of a RIFLEX file: dict CMPTYP-ID → BodyData | ConbData."""
+    cur = Cursor(read_lines(path, comment="'"), path)
+    out = {}
+    while not cur.done():
+        line = cur.next("NEW")
+        kind = next((k for k, key in GROUPS.items() if is_keyword(line, key)), None)
+        if kind is None:
+            continue  # another data group or its data
+        comp = _read_group(cur, line, kind, out)
+        out[comp.name] = comp
+        extra = cur.peek()
+        if extra is not None and not starts_group(extra):
+            raise extra.error("data group identifier",
+                              f"unexpected line {extra.text!r} after {kind} {comp.name!r}; "
+                              "expected a new data group (NEW ...) or the end of the file")
+    return out
+
+
+def _next_data(cur, names, owner):
+    """The next line, which must be the data line ``names`` of ``owner``."""
+    if cur.done():
+        last = cur.lines[-1].number if cur.lines else None
+        raise InputError(cur.path, last, names[0], f"unexpected end of file: missing line '{' '.join(names)}' of {owner}")
+    line = cur.next(names[0])
+    if starts_group(line):
+        raise line.error(names[0], f"expected the line '{' '.join(names)}' of {owner}, found {line.text!r}")
+    return line
+
+
+def _non_negative(line, values, names):
+    for name in names:
+        if values[name] < 0.0:
+            raise line.error(name, f"must be >= 0, found {values[name]:g}")
+
+
+def _read_group(cur, head, kind, seen):
+    owner = f"{kind} at line {head.number}"
+    if cur.done():
+        raise InputError(cur.path, head.number, "CMPTYP-ID", f"unexpected end of file: missing CMPTYP-ID of {owner}")
+    line = cur.next("CMPTYP-ID")
+    if keyword_key(line.text)[:1] == ("NEW",) or len(line.words) != 1:
+        raise line.error("CMPTYP-ID", f"expected one component identifier, found {line.text!r}")
+    name = line.words[0]
+    if len(name) > 8:
+        raise line.error("CMPTYP-ID", f"{name!r} is longer than 8 characters")
+    if name in seen:
+        raise line.error("CMPTYP-ID", f"duplicate component {name!r} (first at line {seen[name].line})")
+    owner = f"{kind} {name!r}"
+
+    line = _next_data(cur, ("AM", "AE"), owner)
+    mass = fields(line, ["AM", "AE"])
+    _non_negative(line, mass, ["AM", "AE"])
+
+    line = _next_data(cur, HYDRO, owner)
+    hydro = fields(line, list(HYDRO), kind=[str] + [float] * 6)
+    icoo = coordinate_code(hydro["ICOO"])
+    if icoo is None:
+        raise line.error("ICOO", f"expected GLOBAL or LOCAL, found {hydro['ICOO']!r}")
+    _non_negative(line, hydro, HYDRO[1:])
+
+    common = dict(name=name, am=mass["AM"], ae=mass["AE"], icoo=icoo,
+                  cd=tuple(hydro[k] for k in HYDRO[1:4]), added_mass=tuple(hydro[k] for k in HYDRO[4:]),
+                  path=str(cur.path), line=head.number)
+    if kind == "BODY":
+        return BodyData(**common)
+
+    codes = (0, 0, 0)
+    nxt = cur.peek()
+    if nxt is not None and not starts_group(nxt):
+        line = cur.next("IRX")
+        values = fields(line, list(FREEDOM), kind=int, defaults=dict.fromkeys(FREEDOM, 0))
+        for key in FREEDOM:
+            if values[key] not in (0, 1):
+                raise line.error(key, f"expected 0 (free) or 1 (fixed), found {values[key]}")
+        codes = tuple(values[k] for k in FREEDOM)
+    return ConbData(**common, codes=codes)

@@ -1,0 +1,110 @@
+"""RIFLEX BODY: a lumped mass, volume, drag and added mass at one point of a floating body.
+
+The point sits at offset r (body axes, m) from the body's reference point; its global
+offset is R·r with R the body-to-global rotation.  All loads are the load ON the body,
+global axes, [force N; moment N·m about the reference point].
+
+Static and drag loads (``LumpedBody.load``)::
+
+    weight      F = −AM·g·e_z                       (AM [kg])
+    buoyancy    F = +ρ·g·AE·e_z                     (AE [m³]; applied whatever the depth)
+    drag        F_i = CD_i·vrel_i·|vrel_i|          (CD [N/(m/s)²], per axis)
+                vrel = u_current − (v + ω × R·r)    (water past the point, global)
+
+ICOO=GLOBAL: the drag axes i are the global axes.  ICOO=LOCAL: they are the body's axes
+(vrel is rotated into body axes, the force computed there and rotated back).  In the
+manual LOCAL means the axes of the neighbour line element; on a floating body the
+neighbour is the body itself.  Moments follow from the force acting at the point.
+
+Acceleration loads: the point's translational mass (no rotary inertia of its own)::
+
+    M_p = AM·I + Q·diag(AMX, AMY, AMZ)·Qᵀ        Q = I (GLOBAL) or R (LOCAL)
+    inertia load at the point  F = −M_p·a_p,     a_p = a + α × R·r + ω × (ω × R·r)
+
+transferred to the reference point this splits into
+
+    −M6·[a; α]      M6 = ``mass_matrix``  (kinematics.point_mass_matrix(M_p, R·r))
+    ``velocity_load`` = transfer(−M_p·(ω × (ω × R·r)), R·r)   (centripetal, velocity only)
+
+so the exact total acceleration load is −M6·acceleration + velocity_load.  The added
+mass uses the Morison form −A·a_p (uniform steady current: no water acceleration).
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .kinematics import point_mass_matrix, point_velocity, quad, transfer
+
+E_Z = np.array([0.0, 0.0, 1.0])
+
+
+def _vec3(x):
+    return np.asarray(x, dtype=float).reshape(3)
+
+
+def coordinate_code(icoo):
+    """'GLOBAL' or 'LOCAL' for an ICOO code (first four letters count, any case), else None."""
+    return {"GLOB": "GLOBAL", "LOCA": "LOCAL"}.get(str(icoo)[:4].upper())
+
+
+@dataclass
+class LumpedBody:
+    """RIFLEX BODY attached at ``offset`` (body axes, m) of a floating body.
+
+    am [kg] mass, ae [m³] displaced volume, icoo 'GLOBAL' or 'LOCAL' (axes of cd and
+    added_mass), cd (3,) [N/(m/s)²] quadratic drag per axis, added_mass (3,) [kg]
+    (AMX, AMY, AMZ).  Follows the effect protocol of physics/state.py, plus
+    ``velocity_load`` (see the module docstring for the split of the inertia load).
+    """
+    name: str
+    offset: np.ndarray
+    am: float = 0.0
+    ae: float = 0.0
+    icoo: str = "GLOBAL"
+    cd: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    added_mass: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self):
+        self.offset, self.cd, self.added_mass = _vec3(self.offset), _vec3(self.cd), _vec3(self.added_mass)
+        self.am, self.ae = float(self.am), float(self.ae)
+        code = coordinate_code(self.icoo)
+        if code is None:
+            raise ValueError(f"{self.name}: ICOO must be GLOBAL or LOCAL, got {self.icoo!r}")
+        self.icoo = code
+
+    @property
+    def uses_current(self):
+        return bool(np.any(self.cd != 0.0))
+
+    @property
+    def uses_acceleration(self):
+        return bool(self.am != 0.0 or np.any(self.added_mass != 0.0))
+
+    def _axes(self, rot):
+        """Rotation from the coefficient axes to global axes."""
+        return rot if self.icoo == "LOCAL" else np.eye(3)
+
+    def load(self, motion, env):
+        """Weight, buoyancy and drag on the body [N, N·m], global, about the reference point."""
+        rot = motion.rot
+        r = rot @ self.offset
+        vrel = env.current - point_velocity(motion.velocity, r)
+        q = self._axes(rot)
+        force = q @ (self.cd * quad(q.T @ vrel))
+        force = force + (env.rho * env.g * self.ae - self.am * env.g) * E_Z
+        return transfer(force, r)
+
+    def point_mass(self, motion):
+        """3×3 translational mass M_p of the point [kg], global axes."""
+        q = self._axes(motion.rot)
+        return self.am * np.eye(3) + q @ np.diag(self.added_mass) @ q.T
+
+    def mass_matrix(self, motion):
+        """6×6 mass M6 about the reference point, global axes; acceleration load −M6·[a; α]."""
+        return point_mass_matrix(self.point_mass(motion), motion.rot @ self.offset)
+
+    def velocity_load(self, motion):
+        """Centripetal part of the inertia load [N, N·m]: transfer(−M_p·ω×(ω×R r), R r)."""
+        r = motion.rot @ self.offset
+        w = motion.velocity[3:]
+        return transfer(-self.point_mass(motion) @ np.cross(w, np.cross(w, r)), r)

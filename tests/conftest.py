@@ -1,0 +1,31 @@
+"""Shared test helpers: write a scene, build its FMUs, find the repository's files."""
+from pathlib import Path
+import textwrap
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ROOT / "models"
+
+
+def write_scene(folder, text, name="scene.toml"):
+    path = Path(folder) / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def build(folder, text, name="scene.toml"):
+    """Write a scene into ``folder``, build it into folder/fmus; returns the built scene folder."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    scene = load_scene(write_scene(folder, text, name))
+    return build_scene(scene, Path(folder) / "fmus", log=lambda *_: None)
+
+
+@pytest.fixture(scope="session")
+def demo_build(tmp_path_factory):
+    """The demo scene of models/, built once per session."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    out = tmp_path_factory.mktemp("demo")
+    return build_scene(load_scene(MODELS / "moored_barge.toml"), out, log=lambda *_: None)
