@@ -10,6 +10,7 @@ MODELS = ROOT / "models"
 
 def write_scene(folder, text, name="scene.toml"):
     path = Path(folder) / name
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(textwrap.dedent(text))
     return path
 

@@ -217,11 +217,11 @@ def test_node_loads_side_a_at_the_joint_point():
 
 def test_default_coefficients_numbers():
     mu = 2e6 * 1e6 / 3e6
-    wn = 2 * np.pi / (20 * 0.1)
+    wn = 2 * np.pi / (12 * 0.1)  # default: 12 communication steps per joint period
     assert default_stiffness(2e6, 1e6, 0.1) == pytest.approx(mu * wn ** 2)
     assert default_damping(2e6, 1e6, 0.1) == pytest.approx(2 * 0.7 * mu * wn)
     assert default_stiffness(2e6, None, 0.1, n_steps=40) == pytest.approx(2e6 * (2 * np.pi / 4.0) ** 2)
-    assert default_damping(2e6, None, 0.1, zeta=0.5) == pytest.approx(2e6 * np.pi)
+    assert default_damping(2e6, None, 0.1, zeta=0.5) == pytest.approx(2e6 * 2 * np.pi / 1.2)
 
 
 def test_effective_mass():
@@ -267,7 +267,7 @@ def test_two_masses_jacobi_translation(scale, stable):
     if stable:
         assert gaps[-1] < 1e-8 * 0.05 and gaps.max() < 0.1
     else:
-        assert gaps[-1] > 1e3 * 0.05
+        assert not np.isfinite(gaps[-1]) or gaps[-1] > 1e3 * 0.05  # diverged (may overflow)
 
 
 @pytest.mark.parametrize("scale, stable", [(1.0, True), (100.0, False)])

@@ -1,15 +1,16 @@
-"""The FMI status shim: doStep's Discard becomes Error, everything else is forwarded.
+"""The FMI shim: doStep's Discard becomes Error, warnings and errors always reach the
+host's logger, everything else is forwarded.
 
 A tiny pythonfmu FMU (y = 2 x; do_step logs an error and returns False on a
-non-finite x) is built once per module, shimmed, and driven through fmpy and
-libcosimpy.
+non-finite x, else logs an info line) is built once per module, shimmed, and driven
+through fmpy and libcosimpy.
 """
 
 import math
 import shutil
 import uuid
 import zipfile
-from ctypes import byref
+from ctypes import byref, c_double, c_void_p
 
 import pytest
 
@@ -22,6 +23,7 @@ from fmpy.fmi2 import (  # noqa: E402
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
     fmi2Error,
+    fmi2OK,
 )
 from fmpy.validation import validate_fmu  # noqa: E402
 
@@ -50,12 +52,14 @@ class {cls}(Fmi2Slave):
         self.y = 0.0
         self.register_variable(Real("x", causality=Fmi2Causality.input))
         self.register_variable(Real("y", causality=Fmi2Causality.output))
+        self.log("made")  # an info line logged inside fmi2Instantiate
 
     def do_step(self, current_time, step_size):
         if not math.isfinite(self.x):
             self.log("x is not finite", status=Fmi2Status.error)
             return False
         self.y = 2.0 * self.x
+        self.log("hello 100% %s")  # info, category logAll; '%' is literal text
         return True
 '''
 
@@ -82,19 +86,46 @@ def fmus(tmp_path_factory):
     return plain, shimmed
 
 
-def _slave(fmu, name, tmp_path, messages):
-    """An instantiated, initialised FMU2Slave whose log messages go to ``messages``."""
+# fmpy's logger proxy forwards to ONE process-global Python logger (the last one given
+# to addLoggerProxy), also for FMUs using fmpy's default callbacks.  A test that
+# proxies its own logger must point the proxy back at a logger that lives forever,
+# else a later FMU that logs calls a freed ctypes thunk and the process crashes.
+_KEEP = fmi2CallbackFunctions()
+_KEEP.logger = fmi2CallbackLoggerTYPE(fmpy.fmi2.printLogMessage)
+
+
+@pytest.fixture
+def proxy_restored():
+    yield
+    from fmpy.logging import addLoggerProxy
+
+    addLoggerProxy(byref(_KEEP))
+
+
+def _slave(fmu, name, tmp_path, messages, logging=True, env=None, proxy=False):
+    """An instantiated, initialised FMU2Slave whose log messages go to ``messages``.
+
+    ``messages`` gets (status, text), or (env, status, text) when ``env`` (an int
+    given as the host's componentEnvironment) is set.  ``proxy`` puts fmpy's
+    printf-formatting proxy in front of the logger, as a C host would format.
+    """
     md = read_model_description(str(fmu))
     unzipped = extract(str(fmu), unzipdir=str(tmp_path / name))
     s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped,
                   modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
 
-    def log(env, inst, status, cat, msg):
-        messages.append((status, msg.decode()))
+    def log(e, inst, status, cat, msg):
+        messages.append((status, msg.decode()) if env is None else (e, status, msg.decode()))
 
     cb = fmi2CallbackFunctions()
     cb.logger = fmi2CallbackLoggerTYPE(log)
-    s.instantiate(callbacks=cb, loggingOn=True)
+    if env is not None:
+        cb.componentEnvironment = c_void_p(env)
+    if proxy:
+        from fmpy.logging import addLoggerProxy
+
+        addLoggerProxy(byref(cb))
+    s.instantiate(callbacks=cb, loggingOn=logging)
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
     s.exitInitializationMode()
@@ -209,7 +240,7 @@ def test_two_instances(fmus, tmp_path):
         b.freeInstance()
 
 
-def test_missing_inner_library_fails_instantiate_with_log(fmus, tmp_path):
+def test_missing_inner_library_fails_instantiate_with_log(fmus, tmp_path, proxy_restored):
     _, shimmed = fmus
     md = read_model_description(str(shimmed))
     mid = md.coSimulation.modelIdentifier
@@ -229,6 +260,107 @@ def test_missing_inner_library_fails_instantiate_with_log(fmus, tmp_path):
     s.freeLibrary()
 
 
+HELLO = "hello 100%% %%s"  # the slave's info line as passed on: '%' doubled (a format)
+
+
+def test_errors_reach_the_host_with_logging_off(fmus, tmp_path):
+    """loggingOn=False (fmpy's default): errors still logged, info lines not."""
+    _, shimmed = fmus
+    msgs = []
+    s, vr = _slave(shimmed, "quiet", tmp_path, msgs, logging=False)
+    try:
+        s.setReal([vr["x"]], [1.0])
+        s.doStep(0.0, 0.1)
+        assert msgs == []  # neither "made" (during instantiate) nor the step's info line
+        s.setReal([vr["x"]], [math.nan])
+        with pytest.raises(FMICallException, match=r"status 3 \(error\)"):
+            s.doStep(0.1, 0.1)
+        assert msgs == [(fmi2Error, "x is not finite")]
+    finally:
+        s.freeInstance()
+
+
+def test_info_lines_follow_the_hosts_logging_switch(fmus, tmp_path):
+    _, shimmed = fmus
+    msgs = []
+    s, vr = _slave(shimmed, "loud", tmp_path, msgs, logging=True)
+    try:
+        assert msgs == [(fmi2OK, "made")]  # logged inside fmi2Instantiate, still routed
+        s.setReal([vr["x"]], [1.0])
+        s.doStep(0.0, 0.1)
+        assert msgs[1:] == [(fmi2OK, HELLO)]
+        s.setDebugLogging(False, [])
+        s.doStep(0.1, 0.1)
+        assert len(msgs) == 2
+        s.setDebugLogging(True, ["logStatusError"])  # a category the info line is not in
+        s.doStep(0.2, 0.1)
+        assert len(msgs) == 2
+        s.setDebugLogging(True, ["logStatusError", "logAll"])  # pythonfmu files info under logAll
+        s.doStep(0.3, 0.1)
+        assert msgs[2:] == [(fmi2OK, HELLO)]
+    finally:
+        s.freeInstance()
+
+
+def test_set_debug_logging_turns_info_lines_on(fmus, tmp_path):
+    _, shimmed = fmus
+    msgs = []
+    s, vr = _slave(shimmed, "later", tmp_path, msgs, logging=False)
+    try:
+        s.setReal([vr["x"]], [1.0])
+        s.doStep(0.0, 0.1)
+        assert msgs == []
+        s.setDebugLogging(True, [])  # no categories: all of them
+        s.doStep(0.1, 0.1)
+        assert msgs == [(fmi2OK, HELLO)]
+    finally:
+        s.freeInstance()
+
+
+def test_formatting_host_sees_the_literal_text(fmus, tmp_path, proxy_restored):
+    """A C host formats the message (here fmpy's vsnprintf proxy): '%' must stay literal."""
+    _, shimmed = fmus
+    msgs = []
+    s, vr = _slave(shimmed, "fmt", tmp_path, msgs, logging=True, proxy=True)
+    try:
+        s.setReal([vr["x"]], [1.0])
+        s.doStep(0.0, 0.1)
+        assert msgs == [(fmi2OK, "made"), (fmi2OK, "hello 100% %s")]
+    finally:
+        s.freeInstance()
+
+
+def test_instances_log_to_their_own_environment(fmus, tmp_path):
+    _, shimmed = fmus
+    la, lb = [], []
+    a, vr = _slave(shimmed, "a", tmp_path, la, logging=True, env=0x1111)
+    b, _ = _slave(shimmed, "b", tmp_path, lb, logging=False, env=0x2222)
+    try:
+        a.setReal([vr["x"]], [1.0])
+        b.setReal([vr["x"]], [math.nan])
+        a.doStep(0.0, 0.1)
+        with pytest.raises(FMICallException):
+            b.doStep(0.0, 0.1)
+        assert la == [(0x1111, fmi2OK, "made"), (0x1111, fmi2OK, HELLO)]
+        assert lb == [(0x2222, fmi2Error, "x is not finite")]
+    finally:
+        a.freeInstance()
+        b.freeInstance()
+
+
+def test_null_component_is_an_error_not_a_crash(fmus, tmp_path):
+    _, shimmed = fmus
+    s, _ = _slave(shimmed, "null", tmp_path, [])
+    try:
+        dll = s.dll
+        assert dll.fmi2DoStep(None, c_double(0.0), c_double(0.1), 0) == fmi2Error
+        assert dll.fmi2SetDebugLogging(None, 1, 0, None) == fmi2Error
+        assert dll.fmi2Terminate(None) == fmi2Error
+        dll.fmi2FreeInstance(None)
+    finally:
+        s.freeInstance()
+
+
 def test_simulate_fmu(fmus):
     _, shimmed = fmus
     res = simulate_fmu(str(shimmed), stop_time=1.0, output_interval=0.1,
@@ -242,7 +374,7 @@ def test_validate_no_new_problems(fmus):
     assert set(validate_fmu(str(shimmed))) <= set(validate_fmu(str(plain)))
 
 
-def test_libcosimpy(fmus):
+def test_libcosimpy(fmus, capfd):
     pytest.importorskip("libcosimpy")
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimObserver import CosimObserver
@@ -266,3 +398,6 @@ def test_libcosimpy(fmus):
     c = bad.add_local_slave(CosimLocalSlave(fmu_path=str(shimmed), instance_name="c"))
     bad.real_initial_value(c, vr["x"], math.nan)
     assert not bad.simulate_until(target_time=int(1e9))
+    # libcosim instantiates with logging off; the error still reaches its log
+    out = capfd.readouterr()
+    assert "x is not finite" in out.out + out.err

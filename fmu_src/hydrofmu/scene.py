@@ -250,11 +250,109 @@ def _deeplines_current_polar(problems, table, where):
             "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
 
 
+LUMPED_KEYS = {"am", "ae", "icoo", "cd", "added_mass"}
+
+
+def _lumped_data(problems, table, where, kind):
+    """RIFLEX lumped properties (AM, AE, ICOO, CD, added mass) from a deck component or
+    inline; ``kind`` is 'BODY' or 'CONB'.  Returns (data dict, conb codes or None)."""
+    from .decks.riflex import BodyData, ConbData, read_components
+    if "deck" in table:
+        comp, path = _from_deck(problems, table, where, read_components, "component")
+        if comp is None:
+            return None, None
+        want = BodyData if kind == "BODY" else ConbData
+        if not isinstance(comp, want):
+            problems.add(f"{where}.component", f"{table['component']!r} in {path.name} is not a "
+                                               f"NEW COMPonent {kind} data group")
+            return None, None
+        data = {"am": comp.am, "ae": comp.ae, "icoo": comp.icoo, "cd": list(comp.cd),
+                "added_mass": list(comp.added_mass)}
+        return data, (list(comp.codes) if kind == "CONB" else None)
+    data = {
+        "am": problems.number(table, "am", f"{where}.am", 0.0, nonneg=True),
+        "ae": problems.number(table, "ae", f"{where}.ae", 0.0, nonneg=True),
+        "icoo": problems.choice(table, "icoo", f"{where}.icoo", ("GLOBAL", "LOCAL"), "GLOBAL"),
+        "cd": problems.vector(table, "cd", f"{where}.cd", 3, [0.0] * 3),
+        "added_mass": problems.vector(table, "added_mass", f"{where}.added_mass", 3, [0.0] * 3),
+    }
+    codes = None
+    if kind == "CONB":
+        codes = problems.vector(table, "codes", f"{where}.codes", 3, [0, 0, 0])
+        if codes is not None and any(c not in (0, 1) for c in codes):
+            problems.add(f"{where}.codes", f"freedom codes IRX IRY IRZ must be 0 (free) or 1 (fixed), found {codes}")
+            codes = None
+    if any(v is None for v in data.values()) or (kind == "CONB" and codes is None):
+        return None, None
+    return data, ([int(c) for c in codes] if codes is not None else None)
+
+
+def _riflex_body(problems, table, where):
+    keys = {"type", "name", "offset"} | ({"deck", "component"} if "deck" in table else LUMPED_KEYS)
+    problems.known_keys(table, where, keys)
+    offset = problems.vector(table, "offset", f"{where}.offset", 3)
+    data, _ = _lumped_data(problems, table, where, "BODY")
+    if data is None or offset is None:
+        return None
+    return {**data, "offset": offset}
+
+
 # type -> (validator, default effect name)
 EFFECT_TYPES = {
     "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
     "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),
+    "riflex_body": (_riflex_body, "riflex_body"),
 }
+
+JOINT_KEYS = {"type", "a", "a_point", "b", "b_point", "stiffness", "damping", "rot_stiffness",
+              "rot_damping", "acceleration_loads"}
+
+
+@dataclass
+class Joint:
+    """A CONB ball joint between body ``a`` and body ``b`` (None: the earth).
+    ``a_point``: joint point in A's body axes; ``b_point``: in B's body axes, or global
+    for the earth (default: where A's point is at t = 0).  ``codes``: IRX IRY IRZ about
+    A's axes (1 fixed, 0 free).  Spring/damper values None mean the build's defaults."""
+    name: str
+    a: str
+    b: object
+    a_point: list
+    b_point: object
+    codes: list
+    node: dict
+    stiffness: object = None
+    damping: object = None
+    rot_stiffness: object = None
+    rot_damping: object = None
+    accel_mode: str = "export"
+
+
+def _joint(problems, name, table, where, bodies):
+    keys = JOINT_KEYS | ({"deck", "component"} if "deck" in table else LUMPED_KEYS | {"codes"})
+    problems.known_keys(table, where, keys)
+    if not identifier(name) or name in bodies or name.endswith("_dynamics"):
+        problems.add(where, "joint name must be an identifier that is not a body's name")
+    problems.choice(table, "type", f"{where}.type", ("riflex_conb",), "riflex_conb")
+    a = problems.string(table, "a", f"{where}.a")
+    b = table.get("b", "earth")
+    for side, value in (("a", a), ("b", b)):
+        if value is not None and value != "earth" and value not in bodies:
+            problems.add(f"{where}.{side}", f"{value!r} is not a body of this scene"
+                                            + (" (side a cannot be the earth)" if value == "earth" else ""))
+    if a == "earth":
+        problems.add(f"{where}.a", "side a must be a body (name the earth as side b)")
+    if a is not None and a == b:
+        problems.add(f"{where}.b", "a joint needs two different sides")
+    a_point = problems.vector(table, "a_point", f"{where}.a_point", 3)
+    b_point = problems.vector(table, "b_point", f"{where}.b_point", 3) if "b_point" in table else None
+    node, codes = _lumped_data(problems, table, where, "CONB")
+    optional = {k: (problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None)
+                for k in ("stiffness", "damping", "rot_stiffness", "rot_damping")}
+    mode = problems.choice(table, "acceleration_loads", f"{where}.acceleration_loads", ACCEL_MODES, "export")
+    if node is None or a_point is None:
+        return None
+    return Joint(name, a, None if b == "earth" else b, a_point, b_point, codes, node, accel_mode=mode, **optional)
 
 BODY_KEYS = {"position", "attitude", "velocity", "mass", "inertia", "cog", "stiffness", "damping",
              "acceleration_loads", "effects"}
@@ -347,8 +445,17 @@ def load_scene(path):
         bodies[bname] = _body(p, bname, btable, f"bodies.{bname}")
     if not bodies and "bodies" in doc:
         p.add("bodies", "a scene needs at least one body")
+    joints = {}
+    joints_t = p.table(doc, "joints", "joints", required=False) or {}
+    for jname, jtable in joints_t.items():
+        if not isinstance(jtable, dict):
+            p.add(f"joints.{jname}", "expected a table")
+            continue
+        joint = _joint(p, jname, jtable, f"joints.{jname}", bodies)
+        if joint is not None:
+            joints[jname] = joint
     scene = Scene(
-        name=name, path=path,
+        name=name, path=path, joints=joints,
         rho=p.number(env, "rho", "environment.rho", 1025.0, positive=True),
         g=p.number(env, "g", "environment.g", 9.81, positive=True),
         current_speed=p.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),

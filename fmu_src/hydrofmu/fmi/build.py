@@ -23,7 +23,11 @@ import numpy as np
 
 from . import model_description
 from .slave import CONFIG
+from ..physics import joint as conb
+from ..physics.kinematics import rotation
 from ..physics.loads import BodyLoads, make_effect
+from ..physics.lumped import LumpedBody
+from ..physics.rigid_body import RigidBody
 from ..physics.state import Motion
 
 PACKAGE = Path(__file__).resolve().parents[1]
@@ -62,41 +66,116 @@ def initial_motion(body):
     return Motion(np.array(body.position, float), np.array(body.attitude, float))
 
 
+def exported_mass(scene):
+    """Per body: the 6×6 mass its load FMU and the joints' nodes on it export (export mode)."""
+    out = {}
+    for body in scene.bodies.values():
+        m = np.zeros((6, 6))
+        if body.accel_mode == "export":
+            m += body_loads(scene, body).mass_matrix(initial_motion(body))
+        out[body.name] = m
+    for joint in scene.joints.values():
+        node = joint_node(joint)
+        if joint.accel_mode == "export" and node.uses_acceleration:
+            out[joint.a] = out[joint.a] + node.mass_matrix(initial_motion(scene.bodies[joint.a]))
+    return out
+
+
+def joint_node(joint):
+    return LumpedBody("node", joint.a_point, **joint.node)
+
+
+def joint_config(scene, joint, exported):
+    """BallJoint parameters: points, initial relative rotation and, where the scene leaves
+    them out, the default spring–damper for the scene's communication step."""
+    a, b = scene.bodies[joint.a], scene.bodies.get(joint.b)
+    point_a_world = np.array(a.position) + rotation(a.attitude) @ np.array(joint.a_point)
+    if joint.b_point is not None:
+        point_b = np.array(joint.b_point)
+    elif b is None:
+        point_b = point_a_world
+    else:
+        point_b = rotation(b.attitude).T @ (point_a_world - np.array(b.position))
+
+    def effective(body, point):
+        mass6 = RigidBody(body.mass, body.inertia, body.cog, added_mass=exported[body.name],
+                          attitude0=body.attitude).mass_matrix()
+        return conb.effective_mass(mass6, rotation(body.attitude) @ point)
+
+    m_a, i_a = effective(a, np.array(joint.a_point))
+    m_b, i_b = effective(b, point_b) if b is not None else (None, None)
+    dt = scene.run["step"]
+    pick = lambda given, default: float(given) if given is not None else float(default)
+    return {
+        "point_a": list(joint.a_point), "point_b": point_b.tolist(),
+        "k_lin": pick(joint.stiffness, conb.default_stiffness(m_a, m_b, dt)),
+        "c_lin": pick(joint.damping, conb.default_damping(m_a, m_b, dt)),
+        "k_rot": pick(joint.rot_stiffness, conb.default_stiffness(i_a, i_b, dt)),
+        "c_rot": pick(joint.rot_damping, conb.default_damping(i_a, i_b, dt)),
+        "free": [c == 0 for c in joint.codes],
+        "r_rel0": conb.initial_relative_rotation(a.attitude, b.attitude if b is not None else None).tolist(),
+    }
+
+
 def fmu_specs(scene):
-    """What to build: one dict per FMU instance, in Gauss–Seidel order (loads first, so
-    that every FMU steps from t_k with inputs that are values at t_k)."""
+    """What to build: one dict per FMU instance, in Gauss–Seidel order (load and joint
+    FMUs first, so that every FMU steps from t_k with inputs that are values at t_k).
+    ``motion``: input prefix -> dynamics instance it reads; ``forces``: (output group,
+    dynamics instance, input group) routes."""
     env = {"rho": scene.rho, "g": scene.g, "current_speed": scene.current_speed,
            "current_direction": scene.current_direction}
-    loads_specs, dyn_specs = [], []
+    exported = exported_mass(scene)
+    loads_specs, joint_specs, dyn_specs = [], [], []
     for body in scene.bodies.values():
-        loads = body_loads(scene, body)
-        exported = (np.zeros((6, 6)) if body.accel_mode == "explicit"
-                    else loads.mass_matrix(initial_motion(body)))
+        dyn = f"{body.name}_dynamics"
+        sources = [""] + [j.name for j in scene.joints.values() if body.name in (j.a, j.b)]
         dyn_specs.append({
-            "instance": f"{body.name}_dynamics", "model_id": f"{scene.name}_{body.name}_dynamics",
-            "slave": "DynamicsSlave", "kind": "dynamics", "body": body.name,
+            "instance": dyn, "model_id": f"{scene.name}_{body.name}_dynamics",
+            "slave": "DynamicsSlave", "kind": "dynamics", "body": body.name, "motion": {}, "forces": [],
             "config": {
                 "description": f"6-DOF rigid-body dynamics of '{body.name}' (scene {scene.name})",
                 "mass": body.mass, "inertia": body.inertia, "cog": body.cog,
                 "stiffness": body.stiffness, "damping": body.damping,
                 "position": body.position, "attitude": body.attitude, "velocity": body.velocity,
-                "substep": scene.run["substep"], "load_sources": [""],
-                "added_mass": exported.tolist(),
+                "substep": scene.run["substep"], "load_sources": sources,
+                "added_mass": exported[body.name].tolist(),
             },
         })
         loads_specs.append({
             "instance": body.name, "model_id": f"{scene.name}_{body.name}",
             "slave": "LoadSlave", "kind": "load", "body": body.name,
+            "motion": {"": dyn}, "forces": [("force", dyn, "force")],
             "config": {
                 "description": f"hydrodynamic loads on '{body.name}' (scene {scene.name}): "
-                               + ", ".join(f"{e.name} ({e.type})" for e in body.effects),
+                               + (", ".join(f"{e.name} ({e.type})" for e in body.effects) or "no effects"),
                 "body": body.name, "position": body.position, "attitude": body.attitude,
                 "accel_mode": body.accel_mode,
                 "effects": [{"type": e.type, "name": e.name, "data": e.data} for e in body.effects],
                 **env,
             },
         })
-    return loads_specs + dyn_specs
+    for joint in scene.joints.values():
+        a, b = scene.bodies[joint.a], scene.bodies.get(joint.b)
+        motion = {"A.": f"{a.name}_dynamics"}
+        forces = [("A.force", f"{a.name}_dynamics", f"{joint.name}.force")]
+        if b is not None:
+            motion["B."] = f"{b.name}_dynamics"
+            forces.append(("B.force", f"{b.name}_dynamics", f"{joint.name}.force"))
+        joint_specs.append({
+            "instance": joint.name, "model_id": f"{scene.name}_{joint.name}",
+            "slave": "ConnectorSlave", "kind": "joint", "body": a.name, "motion": motion, "forces": forces,
+            "config": {
+                "description": f"RIFLEX CONB ball joint '{joint.name}' between '{a.name}' and "
+                               f"'{b.name if b is not None else 'earth'}' (codes IRX IRY IRZ = "
+                               f"{' '.join(map(str, joint.codes))}, scene {scene.name})",
+                "name": joint.name, "accel_mode": joint.accel_mode, "node": joint.node,
+                "joint": joint_config(scene, joint, exported),
+                "a": {"position": a.position, "attitude": a.attitude},
+                "b": {"position": b.position, "attitude": b.attitude} if b is not None else None,
+                **env,
+            },
+        })
+    return loads_specs + joint_specs + dyn_specs
 
 
 def build_fmu(spec, workdir, runtime, shim=True):
@@ -141,21 +220,18 @@ def rewrite_model_description(fmu, slave):
 
 
 def connections(specs, slaves):
-    """Motion outputs of each body's dynamics → its load FMU's motion inputs (by name),
-    load outputs → dynamics load inputs."""
+    """Motion outputs of the dynamics FMUs → the motion inputs that exist (by name), and
+    load outputs → the dynamics' load inputs, as each spec's routes say."""
     names = {s["instance"]: {v.name for v in slaves[s["instance"]].vars.values()} for s in specs}
     conns = []
     for s in specs:
-        if s["kind"] != "load":
-            continue
-        dyn = f"{s['body']}_dynamics"
-        for group, n in (("position", 3), ("attitude", 3), ("velocity", 6), ("acceleration", 6)):
-            for i in range(1, n + 1):
-                var = f"{group}[{i}]"
-                if var in names[s["instance"]]:
-                    conns.append([dyn, var, s["instance"], var])
-        for i in range(1, 7):
-            conns.append([s["instance"], f"force[{i}]", dyn, f"force[{i}]"])
+        for prefix, dyn in s["motion"].items():
+            for group, n in (("position", 3), ("attitude", 3), ("velocity", 6), ("acceleration", 6)):
+                for i in range(1, n + 1):
+                    if f"{prefix}{group}[{i}]" in names[s["instance"]]:
+                        conns.append([dyn, f"{group}[{i}]", s["instance"], f"{prefix}{group}[{i}]"])
+        for out, dyn, inp in s["forces"]:
+            conns += [[s["instance"], f"{out}[{i}]", dyn, f"{inp}[{i}]"] for i in range(1, 7)]
     return conns
 
 

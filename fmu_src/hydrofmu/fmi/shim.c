@@ -3,19 +3,31 @@
  *
  * This library is installed as binaries/linux64/<id>.so.  It loads the original
  * pythonfmu binary stored beside it as <id>_pythonfmu.so and forwards every FMI
- * call unchanged, with one exception: fmi2DoStep's fmi2Discard becomes
- * fmi2Error.  pythonfmu maps a slave's `do_step -> False` to Discard, but
+ * call, with two changes: fmi2DoStep's fmi2Discard becomes fmi2Error, and
+ * logging follows the standard (below).  pythonfmu maps a slave's `do_step -> False` to Discard, but
  * hydrofmu slaves only return False on bad input and never complete a partial
  * step, so Error is the status the FMI standard asks for.
  *
  * The FMI types are declared here (ABI-compatible with the standard headers)
  * so the shim builds with nothing but a C compiler and libdl.
+ *
+ * Logging: pythonfmu 0.7 drops every message, errors included, unless debug
+ * logging is on.  FMI 2.0 has loggingOn switch debug logging only, so the shim
+ * keeps the inner FMU's logging always on and filters itself: a message reaches
+ * the host's logger when its status is fmi2Warning or worse, or when the host
+ * turned logging on (fmi2Instantiate's loggingOn, fmi2SetDebugLogging) for its
+ * category.  For that the host's handle is the shim's own per-instance struct
+ * (Shim below), which wraps pythonfmu's component; the inner FMU is given a
+ * callback struct whose componentEnvironment is that Shim, so messages route to
+ * the right host even while the inner fmi2Instantiate is still running.
+ * pythonfmu hands over message text, not a format: '%' is doubled on the way.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <pthread.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- FMI 2.0 types (same layout as fmi2TypesPlatform.h / fmi2FunctionTypes.h) ---- */
@@ -60,7 +72,6 @@ typedef const fmi2ValueReference *VRs;
  * exported forwarders.
  */
 #define FMI_STATUS_FUNCS(X) \
-    X(SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]), (c, on, n, cat)) \
     X(SetupExperiment, (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef, fmi2Real t1), (c, tolDef, tol, t0, stopDef, t1)) \
     X(EnterInitializationMode, (fmi2Component c), (c)) \
     X(ExitInitializationMode, (fmi2Component c), (c)) \
@@ -95,6 +106,7 @@ typedef const fmi2ValueReference *VRs;
     X(const char *, GetTypesPlatform, (void)) \
     X(const char *, GetVersion, (void)) \
     X(fmi2Component, Instantiate, (fmi2String name, fmi2Type type, fmi2String guid, fmi2String res, const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean logging)) \
+    X(fmi2Status, SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[])) \
     X(void, FreeInstance, (fmi2Component c)) \
     X(fmi2Status, DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior))
 
@@ -172,9 +184,80 @@ __attribute__((destructor)) static void unload_inner(void) {
     inner_ok = 0;
 }
 
-/* ---- plain forwarders ---- */
-#define FORWARD(name, params, args) \
-    EXPORT fmi2Status fmi2##name params { return ready() ? inner.name args : fmi2Error; }
+/* ---- per-instance data ---- */
+
+/*
+ * The host's handle.  Everything the host gave fmi2Instantiate that the logger
+ * needs is copied here, and `cb` (given to the inner FMU, which keeps a pointer
+ * to it) lives as long as the instance.  FMI 2.0 forbids concurrent calls on one
+ * instance, so no lock is needed for the logging settings.
+ */
+typedef struct {
+    fmi2Component inner;          /* pythonfmu's component */
+    fmi2CallbackFunctions cb;     /* the inner FMU's callbacks: ours, environment = this Shim */
+    fmi2CallbackLogger logger;    /* the host's logger (may be NULL) ... */
+    fmi2StepFinished stepFinished;
+    fmi2ComponentEnvironment env; /* ... and its componentEnvironment */
+    fmi2CallbackFreeMemory release; /* frees this struct and `cats`: host's freeMemory or free */
+    void *(*alloc)(size_t, size_t); /* host's allocateMemory or calloc, paired with `release` */
+    int logging;                  /* host's loggingOn */
+    size_t ncat;                  /* host's categories; none = all */
+    char **cats;                  /* one block: ncat pointers, then the strings */
+} Shim;
+
+/* Should a message of this status and category reach the host? */
+static int wanted(const Shim *s, fmi2Status st, fmi2String cat) {
+    if (st != fmi2OK) return 1; /* Warning, Discard, Error, Fatal: always */
+    if (!s->logging) return 0;
+    if (s->ncat == 0) return 1;
+    for (size_t i = 0; i < s->ncat; i++)
+        if (strcmp(s->cats[i], cat ? cat : "") == 0) return 1;
+    return 0;
+}
+
+/*
+ * The inner FMU's logger.  pythonfmu passes the message text as the format with
+ * no arguments, so `msg` is literal text: any '%' is doubled before it goes to
+ * the host, whose logger treats the message as a printf format.
+ */
+static void shim_logger(fmi2ComponentEnvironment e, fmi2String name, fmi2Status st,
+                        fmi2String cat, fmi2String msg, ...) {
+    const Shim *s = e;
+    if (!s || !s->logger || !msg || !wanted(s, st, cat)) return;
+    size_t n = strlen(msg), k = 0;
+    for (const char *p = strchr(msg, '%'); p; p = strchr(p + 1, '%')) k++;
+    if (k == 0) {
+        s->logger(s->env, name, st, cat, msg);
+        return;
+    }
+    char small[1024];
+    char *buf = n + k < sizeof small ? small : malloc(n + k + 1);
+    if (!buf) {
+        s->logger(s->env, name, st, cat, "(message lost: out of memory)");
+        return;
+    }
+    char *q = buf;
+    for (const char *p = msg; *p; p++) {
+        *q++ = *p;
+        if (*p == '%') *q++ = '%';
+    }
+    *q = '\0';
+    s->logger(s->env, name, st, cat, buf);
+    if (buf != small) free(buf);
+}
+
+static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
+    const Shim *s = e;
+    if (s && s->stepFinished) s->stepFinished(s->env, st);
+}
+
+/* ---- plain forwarders: unwrap the Shim, call the inner function ---- */
+#define FORWARD(name, params, args)                       \
+    EXPORT fmi2Status fmi2##name params {                 \
+        if (!ready() || !c) return fmi2Error;             \
+        c = ((Shim *)c)->inner;                           \
+        return inner.name args;                           \
+    }
 FMI_STATUS_FUNCS(FORWARD)
 #undef FORWARD
 
@@ -190,19 +273,84 @@ EXPORT const char *fmi2GetVersion(void) {
 EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
                                      fmi2String res, const fmi2CallbackFunctions *cb,
                                      fmi2Boolean visible, fmi2Boolean logging) {
-    if (ready()) return inner.Instantiate(name, type, guid, res, cb, visible, logging);
-    if (cb && cb->logger)
-        cb->logger(cb->componentEnvironment, name ? name : "", fmi2Error, "logStatusError",
-                   "hydrofmu shim: %s", inner_err);
-    return NULL;
+    fmi2CallbackLogger log = cb ? cb->logger : NULL;
+    fmi2ComponentEnvironment env = cb ? cb->componentEnvironment : NULL;
+    if (!ready()) {
+        if (log) log(env, name ? name : "", fmi2Error, "logStatusError", "hydrofmu shim: %s", inner_err);
+        return NULL;
+    }
+    /* the host's allocator when it gave both halves, else the C library's */
+    int host_mem = cb && cb->allocateMemory && cb->freeMemory;
+    void *(*alloc)(size_t, size_t) = host_mem ? cb->allocateMemory : calloc;
+    Shim *s = alloc(1, sizeof *s);
+    if (!s) {
+        if (log) log(env, name ? name : "", fmi2Error, "logStatusError", "hydrofmu shim: out of memory");
+        return NULL;
+    }
+    memset(s, 0, sizeof *s); /* allocateMemory must zero, but a host may not */
+    s->logger = log;
+    s->env = env;
+    s->stepFinished = cb ? cb->stepFinished : NULL;
+    s->alloc = alloc;
+    s->release = host_mem ? cb->freeMemory : free;
+    s->logging = logging != 0;
+    /* the members are const: build the struct, then copy it in */
+    fmi2CallbackFunctions mine = {shim_logger,
+                                  cb ? cb->allocateMemory : NULL,
+                                  cb ? cb->freeMemory : NULL,
+                                  s->stepFinished ? shim_step_finished : NULL,
+                                  s};
+    memcpy(&s->cb, &mine, sizeof mine);
+    /* inner logging always on: the filtering is done in shim_logger */
+    s->inner = inner.Instantiate(name, type, guid, res, &s->cb, visible, 1);
+    if (!s->inner) {
+        s->release(s);
+        return NULL;
+    }
+    return s;
 }
 
 EXPORT void fmi2FreeInstance(fmi2Component c) {
-    if (ready()) inner.FreeInstance(c);
+    Shim *s = c;
+    if (!s) return;
+    if (ready()) inner.FreeInstance(s->inner); /* may still log: s stays valid until after */
+    if (s->cats) s->release(s->cats);
+    s->release(s);
+}
+
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n,
+                                      const fmi2String cat[]) {
+    Shim *s = c;
+    if (!ready() || !s) return fmi2Error;
+    if (!on) n = 0;
+    if (n && !cat) return fmi2Error;
+    /* copy the categories into one block: n pointers, then the strings */
+    char **cats = NULL;
+    if (n) {
+        size_t bytes = n * sizeof *cats;
+        for (size_t i = 0; i < n; i++) bytes += strlen(cat[i] ? cat[i] : "") + 1;
+        cats = s->alloc(1, bytes);
+        if (!cats) {
+            shim_logger(s, "", fmi2Error, "logStatusError", "hydrofmu shim: out of memory");
+            return fmi2Error;
+        }
+        char *q = (char *)(cats + n);
+        for (size_t i = 0; i < n; i++) {
+            size_t len = strlen(cat[i] ? cat[i] : "") + 1;
+            memcpy(q, cat[i] ? cat[i] : "", len);
+            cats[i] = q;
+            q += len;
+        }
+    }
+    if (s->cats) s->release(s->cats);
+    s->cats = cats;
+    s->ncat = n;
+    s->logging = on != 0;
+    return inner.SetDebugLogging(s->inner, 1, 0, NULL);
 }
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior) {
-    if (!ready()) return fmi2Error;
-    fmi2Status s = inner.DoStep(c, t, h, noPrior);
+    if (!ready() || !c) return fmi2Error;
+    fmi2Status s = inner.DoStep(((Shim *)c)->inner, t, h, noPrior);
     return s == fmi2Discard ? fmi2Error : s;
 }

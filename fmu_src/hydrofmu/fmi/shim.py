@@ -2,8 +2,11 @@
 
 pythonfmu maps a slave's ``do_step`` returning False to ``fmi2Discard``; hydrofmu
 slaves return False only on bad input (they never complete a partial step), so the
-shim turns that ``fmi2DoStep`` status into ``fmi2Error`` and forwards everything
-else unchanged.  Layout inside the FMU after ``install_shim``::
+shim turns that ``fmi2DoStep`` status into ``fmi2Error``.  pythonfmu also drops every
+log message while the host's logging is off; the shim keeps the inner FMU's logging
+on and passes warnings and errors to the host always, other messages only when the
+host's logging is on for their category.  Everything else is forwarded unchanged.
+Layout inside the FMU after ``install_shim``::
 
     binaries/linux64/<id>.so            the shim (compiled from shim.c)
     binaries/linux64/<id>_pythonfmu.so  pythonfmu's original binary, loaded by the shim

@@ -17,7 +17,9 @@ import numpy as np
 from pythonfmu import Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
+from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
+from ..physics.lumped import LumpedBody
 from ..physics.rigid_body import RigidBody
 from ..physics.state import Env, Motion
 
@@ -71,6 +73,54 @@ class ArraySlave(Fmi2Slave):
             self.add(f"{name}[{i + 1}]", causality, units[i], start[i],
                      description if i == 0 else None)
         return slice(first, first + n)
+
+    def add_motion(self, prefix, position, attitude, acceleration=False, who="reference point"):
+        """Motion inputs <prefix>position/attitude/velocity[/acceleration]; returns their slices."""
+        In = Fmi2Causality.input
+        slices = [
+            self.add_vector(f"{prefix}position", 3, In, "m", position, f"{who} position, global axes"),
+            self.add_vector(f"{prefix}attitude", 3, In, "rad", attitude,
+                            "roll, pitch, yaw; R = Rz(yaw) Ry(pitch) Rx(roll)"),
+            self.add_vector(f"{prefix}velocity", 6, In, LIN_ROT["velocity"], None,
+                            f"{who} velocity and angular velocity, global axes"),
+        ]
+        if acceleration:
+            slices.append(self.add_vector(f"{prefix}acceleration", 6, In, LIN_ROT["acceleration"], None,
+                                          f"{who} acceleration, global axes"))
+        return slices
+
+    def add_environment(self, uses_current):
+        """current.speed/direction inputs (if used) and rho, g parameters."""
+        cfg = self.config
+        self.current = None
+        if uses_current:
+            self.current = slice(len(self._start), len(self._start) + 2)
+            self.add("current.speed", Fmi2Causality.input, "m/s", cfg["current_speed"], "uniform current speed")
+            self.add("current.direction", Fmi2Causality.input, "deg", cfg["current_direction"],
+                     "current 'going to' direction, counter-clockwise from global +x")
+        self.rho = self.add("rho", Fmi2Causality.parameter, "kg/m3", cfg["rho"], "water density")
+        self.g = self.add("g", Fmi2Causality.parameter, "m/s2", cfg["g"], "acceleration of gravity")
+        return [self.current] if self.current else []
+
+    def add_mass_export(self, name, matrix):
+        """Calculated parameters name[i,j]: a 6×6 mass contribution for the dynamics side."""
+        first = len(self._start)
+        for i in range(6):
+            for j in range(6):
+                self.add(f"{name}[{i + 1},{j + 1}]", Fmi2Causality.calculatedParameter, MASS_UNITS[i][j],
+                         matrix[i, j], "exported added/point mass about the reference point, global axes "
+                                       "(row = load dof)" if i == j == 0 else None)
+        return slice(first, first + 36)
+
+    def motion(self, slices, values=None):
+        v = self.values if values is None else values
+        acc = v[slices[3]] if len(slices) > 3 else np.zeros(6)
+        return Motion(v[slices[0]], v[slices[1]], v[slices[2]], acc)
+
+    def env(self):
+        v = self.values
+        speed, direction = (v[self.current] if self.current else (0.0, 0.0))
+        return Env(v[self.rho], v[self.g], speed, direction)
 
     def finish_registration(self):
         self.values = np.array(self._start, dtype=float)
@@ -148,66 +198,29 @@ class LoadSlave(ArraySlave):
         cfg = self.config
         explicit = cfg["accel_mode"] == "explicit"
         self.loads = BodyLoads([make_effect(e["type"], e["name"], e["data"]) for e in cfg["effects"]], explicit)
-        In, Out, Par = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
-
-        self.position = self.add_vector("position", 3, In, "m", cfg["position"],
-                                        "reference point position, global axes")
-        self.attitude = self.add_vector("attitude", 3, In, "rad", cfg["attitude"],
-                                        "roll, pitch, yaw; R = Rz(yaw) Ry(pitch) Rx(roll)")
-        self.velocity = self.add_vector("velocity", 6, In, LIN_ROT["velocity"], None,
-                                        "reference point velocity and angular velocity, global axes")
-        motion_inputs = [self.position, self.attitude, self.velocity]
-        self.acceleration = None
-        if explicit and self.loads.uses_acceleration:
-            self.acceleration = self.add_vector("acceleration", 6, In, LIN_ROT["acceleration"], None,
-                                                "reference point acceleration, global axes")
-            motion_inputs.append(self.acceleration)
-        self.current = None
-        if self.loads.uses_current:
-            self.current = slice(len(self._start), len(self._start) + 2)
-            self.add("current.speed", In, "m/s", cfg["current_speed"], "uniform current speed")
-            self.add("current.direction", In, "deg", cfg["current_direction"],
-                     "current 'going to' direction, counter-clockwise from global +x")
-        self.rho = self.add("rho", Par, "kg/m3", cfg["rho"], "water density")
-        self.g = self.add("g", Par, "m/s2", cfg["g"], "acceleration of gravity")
-
+        Out = Fmi2Causality.output
+        self.motion_inputs = self.add_motion("", cfg["position"], cfg["attitude"],
+                                             explicit and self.loads.uses_acceleration)
+        inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
         self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
                                      "total load on the body, global axes, moments about the reference point")
         self.effect_force = [self.add_vector(f"{e.name}.force", 6, Out, LIN_ROT["force"], None,
                                              f"load of effect {e.name}")
                              for e in self.loads.effects]
-        inputs = motion_inputs + ([self.current] if self.current else [])
         self.depends([self.force] + self.effect_force, inputs)
         self.inputs = inputs
-
         # export mode: the mass contribution of acceleration loads, for the dynamics side
-        self.mass = None
         if self.loads.uses_acceleration and not explicit:
-            start = self.loads.mass_matrix(self.motion_from(np.array(self._start)))
-            self.mass = slice(len(self._start), len(self._start) + 36)
-            for i in range(6):
-                for j in range(6):
-                    self.add(f"mass_matrix[{i + 1},{j + 1}]", Fmi2Causality.calculatedParameter,
-                             MASS_UNITS[i][j], start[i, j],
-                             "exported added/point mass about the reference point, global axes (row = load dof)"
-                             if i == j == 0 else None)
+            self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
+                                                                                   np.array(self._start))))
         self.finish_registration()
         self.stale = True
-
-    def motion_from(self, values):
-        acc = values[self.acceleration] if self.acceleration else np.zeros(6)
-        return Motion(values[self.position], values[self.attitude], values[self.velocity], acc)
-
-    def env(self):
-        v = self.values
-        speed, direction = (v[self.current] if self.current else (0.0, 0.0))
-        return Env(v[self.rho], v[self.g], speed, direction)
 
     def evaluate(self):
         self.stale = False
         if not self.check_finite(self.inputs):
             return
-        per_effect = self.loads.effect_loads(self.motion_from(self.values), self.env())
+        per_effect = self.loads.effect_loads(self.motion(self.motion_inputs), self.env())
         for s, load in zip(self.effect_force, per_effect):
             self.values[s] = load
         self.values[self.force] = per_effect.sum(axis=0)
@@ -266,6 +279,55 @@ class DynamicsSlave(ArraySlave):
     def set_physics_state(self, state):
         if state is not None:
             self.body.set_state(state)
+
+
+class ConnectorSlave(ArraySlave):
+    """RIFLEX CONB ball joint between side A and side B (or the earth): the motions of
+    both sides in, A.force and B.force out (global axes, each about its own reference
+    point), plus the joint's gap [m] and relative rotation [rad] for monitoring."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        cfg = self.config
+        j = cfg["joint"]
+        node = LumpedBody("node", j["point_a"], **cfg["node"])
+        self.joint = BallJoint(cfg["name"], np.array(j["point_a"]), np.array(j["point_b"]), j["k_lin"], j["c_lin"],
+                               j["k_rot"], j["c_rot"], tuple(j["free"]), node, np.array(j["r_rel0"]))
+        self.explicit = cfg["accel_mode"] == "explicit"
+        Out = Fmi2Causality.output
+        accel = self.explicit and self.joint.uses_acceleration
+        self.side_a = self.add_motion("A.", cfg["a"]["position"], cfg["a"]["attitude"], accel, "side A")
+        self.side_b = (self.add_motion("B.", cfg["b"]["position"], cfg["b"]["attitude"], False, "side B")
+                       if cfg["b"] else None)
+        inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
+        self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,
+                                       "load on side A, global axes, about A's reference point")
+        self.force_b = self.add_vector("B.force", 6, Out, LIN_ROT["force"], None,
+                                       "load on side B (the reaction for the earth), about B's reference point")
+        self.gap = self.add_vector("gap", 3, Out, "m", None, "joint point of B minus joint point of A, global")
+        self.rotation = self.add_vector("rotation", 3, Out, "rad", None, "relative rotation vector, A's axes")
+        self.depends([self.force_a, self.force_b, self.gap, self.rotation], inputs)
+        self.inputs = inputs
+        if self.joint.uses_acceleration and not self.explicit:
+            self.add_mass_export("A.mass_matrix",
+                                 self.joint.mass_matrix(self.motion(self.side_a, np.array(self._start))))
+        self.finish_registration()
+        self.stale = True
+
+    def evaluate(self):
+        self.stale = False
+        if not self.check_finite(self.inputs):
+            return
+        a = self.motion(self.side_a)
+        b = self.motion(self.side_b) if self.side_b else None
+        load_a, load_b = self.joint.loads(a, b, self.env())
+        if self.joint.uses_acceleration:
+            if self.explicit:
+                load_a = load_a - self.joint.mass_matrix(a) @ a.acceleration
+            load_a = load_a + self.joint.velocity_load(a)
+        v = self.values
+        v[self.force_a], v[self.force_b] = load_a, load_b
+        v[self.gap], v[self.rotation] = self.joint.deformation(a, b)
 
 
 def _plain(obj):

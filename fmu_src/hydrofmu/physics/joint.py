@@ -146,7 +146,7 @@ def _reduced(m_a, m_b):
     return float(m_a) if m_b is None else m_a * m_b / (m_a + m_b)
 
 
-def default_stiffness(m_a, m_b, dt, n_steps=20):
+def default_stiffness(m_a, m_b, dt, n_steps=12):
     """Penalty stiffness k = μ·ω_n² [N/m, or N·m/rad with inertias] for a joint that a
     fixed-step explicit (Jacobi) co-simulation with step dt [s] keeps stable.
 
@@ -170,9 +170,12 @@ def default_stiffness(m_a, m_b, dt, n_steps=20):
         Ω < 4ζ   and   Ω < 1/ζ.
 
     Without damping D = 1 + Ω²/2 > 1: the held force pumps energy in at any step, so
-    the damper is required.  Defaults n_steps = 20, ζ = 0.7 give Ω = 0.314 against a
-    limit of 1.43: stable as long as the true reduced mass is above 1/21 of the one
-    passed, and the gap decays by √D ≈ 0.78 per step.  The static gap under a load F
+    the damper is required.  Defaults n_steps = 12, ζ = 0.7 give Ω = 0.524 against a
+    limit of 1.43: stable as long as the true reduced mass is above 0.13 of the one
+    passed (the effective mass passed is already the smallest over all directions), and
+    the gap decays by √D ≈ 0.68 per step.  12 rather than 20 steps per period makes the
+    joint 2.8× stiffer: two 100 m barges in 1 m/s current keep their gap below 1 mm at
+    dt = 0.05 s.  The static gap under a load F
     is F/k, so fewer steps per period (stiffer) shrink the gap and the margin together.
     The same holds for the rotation with inertias (small angles: θ̈ = −m/I_red).
     """
@@ -180,7 +183,7 @@ def default_stiffness(m_a, m_b, dt, n_steps=20):
     return _reduced(m_a, m_b) * w * w
 
 
-def default_damping(m_a, m_b, dt, n_steps=20, zeta=0.7):
+def default_damping(m_a, m_b, dt, n_steps=12, zeta=0.7):
     """Penalty damping c = 2ζ·μ·ω_n [N·s/m, or N·m·s/rad with inertias] matching
     ``default_stiffness`` (same μ and ω_n; analysis there)."""
     return 2.0 * zeta * _reduced(m_a, m_b) * 2.0 * np.pi / (n_steps * dt)

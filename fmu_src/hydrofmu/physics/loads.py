@@ -16,6 +16,7 @@ both modes, since an exported constant M cannot carry it.
 import numpy as np
 
 from .current_polar import CurrentPolar
+from .lumped import LumpedBody
 from .viscous_drag import ViscousDrag
 
 
@@ -28,7 +29,12 @@ def _current_polar(name, d):
                         *d["point"], d["surface"])
 
 
+def _lumped(name, d):
+    return LumpedBody(name, d["offset"], d["am"], d["ae"], d["icoo"], d["cd"], d["added_mass"])
+
+
 KERNELS = {
+    "riflex_body": _lumped,
     "aqwa_viscous_drag": _viscous_drag,
     "deeplines_current_polar": _current_polar,
 }

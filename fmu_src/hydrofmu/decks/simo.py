@@ -1,0 +1,213 @@
+"""SIMO hydrodynamic coupling between bodies: reader for the `HYDRodynamic COUPling DATA` group.
+
+Deck layout (free format, `'` starts a comment line, `&` at the end of a line continues it,
+only the first four letters of each keyword word count, case does not)::
+
+    BODY DATA                        ' minimal body declaration (optional, see below)
+    CHBDY                            ' body identifier
+    HYDRodynamic COUPling DATA
+    CHCPL                            ' coupling identifier, unique in the file
+    TEXT                             ' two free text lines (not blank, not starting with ')
+    TEXT
+    CHBDY_A                          ' body A
+    CHBDY_B                          ' body B (may equal A: the body's own radiation memory)
+    COUPled ADDEd MASS               ' optional sub-group
+    AM11 AM12 … AM16                 ' six rows [kg, kg·m, kg·m²]
+    …
+    COUPled RETArdation FUNCtion     ' optional sub-group (at least one of the two is given)
+    TIMDEL                           ' sample spacing of the kernels [s], > 0
+    RETArdation ELEment DATA
+    NRETij IDOF_A IDOF_B             ' one block per element, repeated until the next group
+    RETij(1) … RETij(NRETij)         ' one line, continued with & [N·s/m, N·s, N·m·s]
+
+Meaning (manual): an acceleration of A in dof i times AM_ij is a force on B in dof j, and an
+acceleration of B in dof j times AM_ij a force on A in dof i; the kernel of block
+(IDOF_A = i, IDOF_B = j) convolves A's velocity in i into B's dof j, and B's velocity in j
+into A's dof i (see physics/coupling.py for the signs).  Units: SI.
+
+Bodies: the manual requires the body data of CHBDY_A and CHBDY_B to precede the coupling.
+A body counts as defined when it is in ``bodies`` (the bodies the scene defines) or when a
+`BODY DATA` group earlier in the same file declares it: the group line followed by one line
+holding the body identifier CHBDY (SIMO's body data group; here only the identifier is read).
+Only these two groups may appear in the file.  A pair of bodies is coupled at most once.
+"""
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .lines import Cursor, Line, convert, fields, is_keyword, read_lines
+
+GROUP = "HYDRodynamic COUPling DATA"
+BODY = "BODY DATA"
+ADDED_MASS = "COUPled ADDEd MASS"
+RETARDATION = "COUPled RETArdation FUNCtion"
+ELEMENTS = "RETArdation ELEment DATA"
+_NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([EeDd][+-]?\d+)?$")
+SYMMETRY_TOL = 1e-3   # self-coupling: max|AM − AMᵀ| ≤ SYMMETRY_TOL·max|AM|
+
+
+@dataclass
+class CouplingData:
+    """One hydrodynamic coupling between bodies A and B (SI units).
+
+    added_mass[i−1, j−1] = AM_ij: couples dof i of A with dof j of B [kg, kg·m, kg·m²].
+    kernels[(i, j)] (1-based IDOF_A, IDOF_B): retardation samples at s = 0, TIMDEL, …
+    timdel [s]: None when the deck gives no retardation function.
+    path, line: where the group starts (for later messages).
+    """
+    name: str
+    text: tuple
+    body_a: str
+    body_b: str
+    added_mass: np.ndarray = field(default_factory=lambda: np.zeros((6, 6)))
+    timdel: float = None
+    kernels: dict = field(default_factory=dict)
+    path: str = ""
+    line: int = None
+
+
+def read_couplings(path, bodies=None):
+    """Read every `HYDRodynamic COUPling DATA` group of a deck: {CHCPL: CouplingData}.
+
+    ``bodies``: identifiers of the bodies defined before this file (e.g. by the scene).
+    Raises InputError (file, line, field) on bad input.
+    """
+    cur = Cursor(read_lines(path, continuation="&"), path)
+    declared = {}                                   # body → line of its BODY DATA group
+    known = set(bodies or ())
+    out, pairs = {}, {}
+    while not cur.done():
+        line = cur.next("data group")
+        if is_keyword(line, BODY):
+            body_line = cur.next("CHBDY")
+            name = fields(body_line, ["CHBDY"], str)["CHBDY"]
+            if name in declared:
+                raise body_line.error("CHBDY", f"body {name!r} declared twice "
+                                               f"(first at line {declared[name]})")
+            declared[name] = body_line.number
+            known.add(name)
+        elif is_keyword(line, GROUP):
+            data = _coupling(cur, line, known, out, pairs)
+            out[data.name] = data
+        else:
+            raise line.error("data group", f"expected {GROUP!r} or {BODY!r}, found {line.text!r}")
+    return out
+
+
+def _coupling(cur, start, known, out, pairs):
+    cl = cur.next("CHCPL")
+    name = _one_word(cl, "CHCPL")
+    if name in out:
+        raise cl.error("CHCPL", f"duplicate coupling identifier {name!r} "
+                                f"(first in the group at line {out[name].line})")
+    text = (cur.next("TEXT").text, cur.next("TEXT").text)
+    body = {}
+    for key in ("CHBDY_A", "CHBDY_B"):
+        bl = cur.next(key)
+        body[key] = _one_word(bl, key, hint=" (two TEXT lines follow CHCPL)")
+        if body[key] not in known:
+            raise bl.error(key, f"body {body[key]!r} is not defined before the coupling "
+                                f"(define it in the scene or in a {BODY!r} group earlier in the file)")
+    pair = frozenset(body.values())
+    if pair in pairs:
+        raise bl.error("CHBDY_B", f"bodies {body['CHBDY_A']!r} and {body['CHBDY_B']!r} are already "
+                                  f"coupled by {pairs[pair]!r}; give each pair once")
+    pairs[pair] = name
+    data = CouplingData(name, text, body["CHBDY_A"], body["CHBDY_B"], path=str(start.path), line=start.number)
+
+    given = False
+    nxt = cur.peek()
+    if nxt is not None and is_keyword(nxt, ADDED_MASS):
+        head, given = cur.next(ADDED_MASS), True
+        for i in range(6):
+            names = [f"AM{i + 1}{j + 1}" for j in range(6)]
+            row = fields(cur.next(names[0]), names)
+            data.added_mass[i] = [row[n] for n in names]
+        if data.body_a == data.body_b:
+            _check_symmetric(head, data.added_mass)
+    nxt = cur.peek()
+    if nxt is not None and is_keyword(nxt, RETARDATION):
+        cur.next(RETARDATION)
+        given = True
+        tl = cur.next("TIMDEL")
+        data.timdel = fields(tl, ["TIMDEL"])["TIMDEL"]
+        if not data.timdel > 0:
+            raise tl.error("TIMDEL", f"must be > 0, found {data.timdel:g}")
+        el = cur.next(ELEMENTS)
+        if not is_keyword(el, ELEMENTS):
+            raise el.error(ELEMENTS, f"expected {ELEMENTS!r}, found {el.text!r}")
+        _blocks(cur, data, el)
+    if not given:
+        where = cur.peek() or cur.lines[-1]
+        raise where.error(ADDED_MASS, f"expected {ADDED_MASS!r} and/or {RETARDATION!r} after CHBDY_B, "
+                                      f"found {where.text if cur.peek() else 'end of file'!r}")
+    return data
+
+
+def _blocks(cur, data, head):
+    """`NRETij IDOF_A IDOF_B` + values blocks, until a line that does not start with a number."""
+    first = {}
+    while cur.peek() is not None and cur.peek().words and _NUMBER.match(cur.peek().words[0]):
+        hl = cur.next("NRETij")
+        f = fields(hl, ["NRETij", "IDOF_A", "IDOF_B"], int)
+        n = f["NRETij"]
+        if n < 1:
+            raise hl.error("NRETij", f"must be ≥ 1, found {n}")
+        for key in ("IDOF_A", "IDOF_B"):
+            if not 1 <= f[key] <= 6:
+                raise hl.error(key, f"degree of freedom must be 1…6, found {f[key]}")
+        dofs = (f["IDOF_A"], f["IDOF_B"])
+        if dofs in first:
+            raise hl.error("IDOF_A IDOF_B", f"duplicate block for (IDOF_A, IDOF_B) = {dofs} "
+                                            f"(first at line {first[dofs]})")
+        first[dofs] = hl.number
+        vl = cur.next("RETij(1)")
+        words = vl.words
+        if len(words) < n:
+            raise _at(vl, len(words) - 1).error(
+                f"RETij({len(words) + 1})", f"NRETij = {n} but {len(words)} values given "
+                                             f"(continue a long line with '&')")
+        if len(words) > n:
+            raise _at(vl, n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
+        data.kernels[dofs] = np.array([convert(_at(vl, k), f"RETij({k + 1})", w, float)
+                                       for k, w in enumerate(words)])
+    if not first:
+        where = cur.peek() or head
+        raise where.error("NRETij", f"expected at least one 'NRETij IDOF_A IDOF_B' block after {ELEMENTS!r}")
+
+
+def _one_word(line, name, hint=""):
+    words = line.words
+    if len(words) != 1:
+        raise line.error(name, f"expected one identifier, found {line.text!r}{hint}")
+    return words[0]
+
+
+def _check_symmetric(head, am):
+    """A body's own added mass must be symmetric (the coupling applies it once, as given)."""
+    diff = np.abs(am - am.T)
+    if diff.max() > SYMMETRY_TOL * np.abs(am).max():
+        i, j = np.unravel_index(np.argmax(diff), diff.shape)
+        raise head.error(f"AM{i + 1}{j + 1}", f"self-coupling added mass must be symmetric: "
+                                              f"AM{i + 1}{j + 1} = {am[i, j]:g} but AM{j + 1}{i + 1} = {am[j, i]:g}")
+
+
+def _at(line, index):
+    """The line (as a Line with its physical number) that holds word ``index`` of a line
+    joined from '&' continuations; read_lines keeps only the first line's number."""
+    try:
+        raw = Path(line.path).read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError:
+        return line
+    count = 0
+    for number in range(line.number, len(raw) + 1):
+        text = raw[number - 1].strip()
+        if not text or text.startswith("'"):
+            continue
+        more = text.endswith("&")
+        count += len((text[:-1] if more else text).replace(",", " ").split())
+        if count > index or not more:
+            return Line(line.path, number, line.text)
+    return line

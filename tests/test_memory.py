@@ -1,0 +1,241 @@
+"""Retardation memory F(t) = −∫ h(s)·v(t − s) ds: convolution and state-space evaluators."""
+import json
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.linalg import expm
+
+from hydrofmu.physics.memory import Convolution, Realisation, StateSpace, realise
+
+A, C, V, W = 0.5, 2.0, 1.3, 1.1          # h(t) = C·e^(−A·t), v = V·sin(W·t)
+
+
+def analytic(t):
+    """−∫₀ᵗ C·e^(−A(t−τ))·V·sin(Wτ) dτ, transient included (v = 0 before t = 0)."""
+    return -C * V * (A * np.sin(W * t) - W * np.cos(W * t) + W * np.exp(-A * t)) / (A * A + W * W)
+
+
+def run(ev, steps):
+    t, out = 0.0, []
+    for dt in steps:
+        t += dt
+        out.append((t, ev.advance(dt, [V * np.sin(W * t)])[0]))
+    return out
+
+
+def max_error(ev, steps, t_end):
+    return max(abs(f - analytic(t)) for t, f in run(ev, steps) if t <= t_end)
+
+
+def variable_steps(base, n):
+    """Steps varying by ±40 % in a pattern that never repeats a TIMDEL multiple."""
+    k = np.arange(n)
+    return base * (1.0 + 0.4 * np.sin(1.7 * k + 0.3))
+
+
+# ---------------------------------------------------------------- convolution: exactness
+
+def pl_kernel(samples, timdel, cut=None):
+    """Reference kernel: linear between samples, zero after the last (and after ``cut``)."""
+    grid = timdel * np.arange(len(samples))
+    end = grid[-1] if cut is None else min(cut, grid[-1])
+    return lambda s: float(np.interp(s, grid, samples)) if 0.0 <= s <= end else 0.0
+
+
+def reference(kernels, timdel, times, vels, cut=None):
+    """−Σ_j ∫ h_ij(s)·v_j(t − s) ds at the last time, by adaptive quadrature (scipy)."""
+    t = times[-1]
+    n_out = 1 + max(i for i, _ in kernels)
+    out = np.zeros(n_out)
+    for (i, j), h in kernels.items():
+        hf = pl_kernel(h, timdel, cut)
+        vj = np.asarray(vels)[:, j]
+        f = lambda s: hf(s) * float(np.interp(t - s, times, vj))
+        pts = sorted(set(np.concatenate([t - np.asarray(times), timdel * np.arange(len(h))])))
+        pts = [p for p in pts if 0.0 < p < t - times[0]]
+        out[i] -= quad(f, 0.0, t - times[0], points=pts or None, limit=500, epsabs=1e-13, epsrel=1e-12)[0]
+    return out
+
+
+@pytest.mark.parametrize("cut", [None, 0.537])
+def test_convolution_is_exact_for_piecewise_linear_kernel_and_velocity(cut):
+    rng = np.random.default_rng(1)
+    timdel = 0.1
+    kernels = {(0, 0): rng.normal(size=9), (0, 1): rng.normal(size=5),   # different lengths,
+               (1, 1): rng.normal(size=12)}                               # jumps to zero at the end
+    ev = Convolution(kernels, timdel, shape=(2, 2), v0=[0.3, -0.2], memory_length=cut)
+    times, vels = [0.0], [[0.3, -0.2]]
+    for dt in rng.uniform(0.013, 0.31, size=25):                          # any step, variable
+        v = rng.normal(size=2)
+        f = ev.advance(dt, v)
+        times.append(times[-1] + dt)
+        vels.append(v)
+        np.testing.assert_allclose(f, reference(kernels, timdel, times, vels, cut), rtol=1e-9, atol=1e-11)
+    assert ev.span == pytest.approx(1.1 if cut is None else cut)
+
+
+def test_truncation_trades_accuracy_for_memory():
+    timdel = 0.01
+    h = C * np.exp(-A * timdel * np.arange(2001))
+    errors, nodes = [], []
+    for length in (2.0, 5.0, 10.0, None):
+        ev = Convolution(h, timdel, memory_length=length)
+        errors.append(max_error(ev, [0.05] * 400, 20.0))
+        nodes.append(ev.nodes)
+    assert errors == sorted(errors, reverse=True) and errors[-1] < 1e-3
+    assert nodes == sorted(nodes)
+    # the neglected tail bounds the error: |F − F_L| ≤ max|v|·∫_L^∞ C·e^(−As) ds
+    assert errors[0] <= V * C * np.exp(-A * 2.0) / A + 1e-3
+
+
+# ---------------------------------------------------------------- convergence to the analytic answer
+
+@pytest.mark.parametrize("method", ["convolution", "state_space"])
+@pytest.mark.parametrize("kind", ["uniform", "variable"])
+def test_converges_to_analytic_response(method, kind):
+    timdel = 0.01                                # dt ≠ TIMDEL, neither divides the other
+    h = C * np.exp(-A * timdel * np.arange(3001))
+    errors = []
+    for base in (0.137, 0.0685, 0.03425):
+        steps = [base] * int(12 / base) if kind == "uniform" else variable_steps(base, int(12 / base))
+        ev = Convolution(h, timdel) if method == "convolution" else StateSpace(h, timdel)
+        errors.append(max_error(ev, steps, 12.0))
+    # v is linear between communication points: second-order convergence
+    assert errors[1] < errors[0] / 3 and errors[2] < errors[1] / 3
+    assert errors[2] < 5e-4
+
+
+def test_state_space_is_exact_at_order_one():
+    a, c, timdel = 0.7, 3.0, 0.05
+    fit = realise(c * np.exp(-a * timdel * np.arange(300)), timdel)
+    assert fit.order == 1 and fit.error < 1e-9
+    assert fit.A[0, 0] == pytest.approx(-a, abs=1e-6)
+    assert fit.C[0] * fit.B[0] == pytest.approx(c, abs=1e-6)
+
+
+def test_state_space_step_matches_block_matrix_exponential():
+    # two modes, one real, one oscillating; compare with scipy's expm of the augmented system
+    a = np.array([[-0.4, 0.0, 0.0], [0.0, -0.2, 1.3], [0.0, -1.3, -0.2]])
+    b, c = np.array([1.0, 1.0, 0.0]), np.array([2.0, -0.7, 0.4])
+    fit = Realisation(a, b, c, 0.0)
+    ev = StateSpace({(0, 0): np.ones(3)}, 0.1, fits={(0, 0): fit})
+    x, v_old = np.zeros(3), 0.0
+    for dt, v_new in [(0.3, 1.0), (0.07, -0.5), (1.9, 0.25), (1e-6, 0.3), (0.3, 0.0)]:
+        m = np.zeros((5, 5))
+        m[:3, :3], m[:3, 3], m[3, 4] = a, b, 1.0
+        e = expm(m * dt)
+        x = e[:3, :3] @ x + e[:3, 3] * v_old + e[:3, 4] * (v_new - v_old) / dt
+        v_old = v_new
+        assert ev.advance(dt, [v_new])[0] == pytest.approx(-c @ x, rel=1e-10, abs=1e-14)
+
+
+def test_realisation_is_c_exp_at_b():
+    t = 0.05 * np.arange(400)
+    h = np.exp(-0.3 * t) * np.cos(0.8 * t) - 0.5 * np.exp(-0.9 * t)
+    fit = realise(h, 0.05, tol=1e-6)
+    for s in (0.0, 0.7, 3.3, 11.0):
+        assert fit([s])[0] == pytest.approx(fit.C @ expm(fit.A * s) @ fit.B, rel=1e-10, abs=1e-12)
+
+
+def test_realistic_radiation_kernel_small_order():
+    timdel = 0.05
+    t = timdel * np.arange(2000)                 # 2000 lags, 100 s
+    h = (1e5 * np.exp(-0.3 * t) * np.cos(0.8 * t) + 4e4 * np.exp(-0.1 * t) * np.cos(0.4 * t)
+         - 2e4 * np.exp(-0.6 * t) * np.cos(1.5 * t))
+    fit = realise(h, timdel, tol=0.01)
+    assert fit.order <= 6
+    assert np.sqrt(np.mean((fit(t) - h) ** 2) / np.mean(h ** 2)) <= 0.01   # error recomputed
+    assert np.all(np.linalg.eigvals(fit.A).real < 0)
+
+
+def test_non_exponential_kernel_small_order():
+    # kernel of the damping B(ω) = ω²·e^(−ω²):
+    # h(t) = (2/π)∫B(ω)·cos(ωt)dω = (1/√π)·(½ − t²/4)·e^(−t²/4)
+    timdel = 0.05
+    t = timdel * np.arange(2000)
+    h = (0.5 - t ** 2 / 4) * np.exp(-t ** 2 / 4) / np.sqrt(np.pi)
+    for tol in (0.05, 0.01):
+        fit = realise(h, timdel, tol=tol)
+        assert fit.error <= tol and fit.order <= 8
+        assert np.sqrt(np.mean((fit(t) - h) ** 2) / np.mean(h ** 2)) == pytest.approx(fit.error)
+    # the two evaluators then agree to the fit error on a random velocity
+    rng = np.random.default_rng(3)
+    conv, ss = Convolution(h, timdel), StateSpace(h, timdel, tol=0.001)
+    fc, fs = [], []
+    for _ in range(600):
+        v = [rng.normal()]
+        fc.append(conv.advance(0.1, v)[0])
+        fs.append(ss.advance(0.1, v)[0])
+    assert np.sqrt(np.mean((np.array(fc) - fs) ** 2) / np.mean(np.square(fc))) < 0.01
+
+
+def test_every_realisation_is_stable():
+    rng = np.random.default_rng(4)
+    t = 0.1 * np.arange(300)
+    noisy = np.exp(-0.2 * t) * np.cos(t) + 0.05 * rng.normal(size=t.size)
+    growing = np.exp(0.05 * t)
+    for h, order in [(noisy, 30), (growing, 1), (growing, 4), (noisy, None)]:
+        fit = realise(h, 0.1, tol=1e-3, order=order)
+        assert fit.order >= 1 and np.all(np.linalg.eigvals(fit.A).real < 0)
+    alternating = (-1.0) ** np.arange(50) * np.exp(-0.1 * np.arange(50))   # Nyquist: dropped
+    fit = realise(alternating, 0.1, order=1)
+    assert fit.order == 0 and fit.error == 1.0
+
+
+# ---------------------------------------------------------------- state and boundedness
+
+@pytest.mark.parametrize("make", [
+    lambda k, d: Convolution(k, d, shape=(2, 3)),
+    lambda k, d: StateSpace(k, d, shape=(2, 3), tol=1e-4),
+])
+def test_state_save_restore_gives_identical_outputs(make):
+    rng = np.random.default_rng(5)
+    timdel = 0.2
+    t = timdel * np.arange(40)
+    kernels = {(0, 0): np.exp(-0.3 * t), (1, 2): np.exp(-0.5 * t) * np.cos(t), (0, 1): -np.exp(-t)}
+    steps, vels = rng.uniform(0.05, 0.5, 120), rng.normal(size=(120, 3))
+    ev = make(kernels, timdel)
+    for dt, v in zip(steps[:60], vels[:60]):
+        ev.advance(dt, v)
+    saved = ev.state()
+    json.dumps(saved)                                        # plain lists
+    first = [ev.advance(dt, v) for dt, v in zip(steps[60:], vels[60:])]
+    assert ev.state() != saved                               # a deep copy, not a view
+    other = make(kernels, timdel)
+    for ev2 in (ev, other):
+        ev2.set_state(json.loads(json.dumps(saved)))
+        again = [ev2.advance(dt, v) for dt, v in zip(steps[60:], vels[60:])]
+        np.testing.assert_array_equal(np.array(again), np.array(first))
+
+
+def test_memory_bounded_over_1e5_steps():
+    timdel, dt = 0.1, 0.03
+    h = np.exp(-0.5 * timdel * np.arange(21))                 # span 2 s
+    conv, ss = Convolution(h, timdel), StateSpace(h, timdel, tol=1e-3)
+    bound = int(2.0 / dt) + 2
+    for n in range(100_000):
+        v = [np.sin(0.01 * n)]
+        conv.advance(dt, v)
+        ss.advance(dt, v)
+        if n % 1000 == 0:
+            assert conv.nodes <= bound and conv._v.shape[0] <= 4 * bound
+    assert len(conv.state()["v"]) <= bound
+    assert len(ss.state()["z_re"]) == len(ss._mu)
+    for n in range(300):                                      # variable steps: bounded cache
+        conv.advance(dt * (1.0 + 0.5 * np.sin(n)), [1.0])
+        ss.advance(dt * (1.0 + 0.5 * np.sin(n)), [1.0])
+    assert len(ss._cache) <= 16 and conv.nodes <= int(2.0 / (0.5 * dt)) + 2
+
+
+def test_zero_and_empty_kernels():
+    ev = Convolution({}, 0.1, shape=(6, 6))
+    assert np.all(ev.advance(0.1, np.ones(6)) == 0.0)
+    ss = StateSpace({(1, 1): np.zeros(5), (2, 2): [4.0]}, 0.1, shape=(6, 6))   # zero, one sample
+    assert ss.order == 0 and np.all(ss.advance(0.1, np.ones(6)) == 0.0)
+    conv = Convolution({(2, 2): [4.0]}, 0.1, shape=(6, 6))
+    assert np.all(conv.advance(0.1, np.ones(6)) == 0.0)
+    with pytest.raises(ValueError):
+        Convolution([1.0, 0.5], 0.1).advance(0.0, [1.0])
+    with pytest.raises(ValueError):
+        StateSpace([1.0, 0.5, 0.2], 0.1).advance(-1.0, [1.0])
