@@ -7,7 +7,6 @@ from pathlib import Path
 from .errors import InputError
 
 DEFAULT_OUT = Path("build") / "fmus"
-DEMO_SCENE = "moored_barge"
 
 
 def scenes_in(paths, models="models"):
@@ -77,9 +76,9 @@ def main(argv=None):
     r.add_argument("--png", type=Path)
     v = sub.add_parser("validate", help="fmpy validation of built FMUs")
     v.add_argument("paths", nargs="*", default=[str(DEFAULT_OUT)])
-    d = sub.add_parser("demo", help="build every scene in models/, run the demo scene, write CSV and PNG")
+    d = sub.add_parser("demo", help="build every scene in models/, run each one, write CSV and PNG per scene")
     d.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
-    d.add_argument("--scene", default=DEMO_SCENE)
+    d.add_argument("--scene", action="append", help="run only this scene (repeatable)")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -95,11 +94,11 @@ def main(argv=None):
             print(f"ran {folder.name}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm})")
         elif args.command == "demo":
             folders = build(scenes_in([]), args.out)
-            folder = folders[args.scene]
-            csv, png = args.out / f"{args.scene}.csv", args.out / f"{args.scene}.png"
-            result = run_folder(folder, "fmpy", csv, png)
-            print(f"ran {args.scene}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm})")
-            print(f"wrote {csv} and {png}")
+            for name in args.scene or folders:
+                csv, png = args.out / f"{name}.csv", args.out / f"{name}.png"
+                result = run_folder(folders[name], "fmpy", csv, png)
+                print(f"ran {name}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm}); "
+                      f"wrote {csv} and {png}")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

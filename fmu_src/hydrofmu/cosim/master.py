@@ -149,6 +149,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         reads = [(system.instances[k].fmu, np.array(cols), np.array(vrs)) for k, (cols, vrs) in by_inst.items()]
         values = np.empty((n + 1, len(record)))
         progress = n > 2000 if progress is None else progress
+        tty = sys.stderr.isatty()
+        every = max(1, n // (20 if tty else 4))  # a live line on a terminal, four lines in a log
 
         def sample(k):
             for fmu, cols, vrs in reads:
@@ -170,12 +172,13 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                     system.transfer(targets={inst.name})
                     inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
                 sample(k + 1)
-            if progress and (k + 1) % max(1, n // 20) == 0:
+            if progress and (k + 1) % every == 0:
                 elapsed = clock.perf_counter() - t0
-                sys.stderr.write(f"\r{system.manifest['scene']}: t = {(k + 1) * step:.1f} s of {stop:g} s "
-                                 f"({100 * (k + 1) / n:.0f} %, {elapsed:.0f} s elapsed)")
+                line = (f"{system.manifest['scene']}: t = {(k + 1) * step:.1f} s of {stop:g} s "
+                        f"({100 * (k + 1) / n:.0f} %, {elapsed:.0f} s elapsed)")
+                sys.stderr.write("\r" + line if tty else line + "\n")
                 sys.stderr.flush()
-        if progress:
+        if progress and tty:
             sys.stderr.write("\n")
         return Result(np.arange(n + 1) * step, list(record), values, algorithm, step)
     finally:
