@@ -304,6 +304,79 @@ EFFECT_TYPES = {
     "riflex_body": (_riflex_body, "riflex_body"),
 }
 
+COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length"}
+
+
+@dataclass
+class Coupling:
+    """A SIMO hydrodynamic coupling between scene bodies ``a`` and ``b`` (a == b: the
+    body's own radiation memory).  ``data``: added_mass (6×6), timdel [s] and kernels
+    [[IDOF_A, IDOF_B, [values…]], …]; ``method``: 'convolution' | 'state_space'
+    (with ``tolerance`` or ``order``); ``memory_length`` [s] truncates the kernels."""
+    name: str
+    a: str
+    b: str
+    data: dict
+    method: str = "convolution"
+    tolerance: float = 0.01
+    order: object = None
+    memory_length: object = None
+
+
+def _couplings(problems, items, bodies):
+    from .decks.simo import read_couplings
+    if not isinstance(items, list):
+        problems.add("couplings", "expected an array of tables ([[couplings]])")
+        return []
+    out, names = [], set()
+    for i, table in enumerate(items):
+        where = f"couplings[{i}]"
+        if not isinstance(table, dict):
+            problems.add(where, "expected a table")
+            continue
+        problems.known_keys(table, where, COUPLING_KEYS)
+        mapping = table.get("bodies", {})
+        if not isinstance(mapping, dict) or any(v not in bodies for v in mapping.values()):
+            problems.add(f"{where}.bodies", "expected a table SIMO body name = scene body name, "
+                                            f"scene bodies: {', '.join(bodies)}")
+            continue
+        known = set(mapping) | set(bodies)
+        path = _deck_path(problems, table, where)
+        name = problems.string(table, "coupling", f"{where}.coupling")
+        method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"), "convolution")
+        tol = problems.number(table, "tolerance", f"{where}.tolerance", 0.01, positive=True)
+        order = table.get("order")
+        if order is not None and (not isinstance(order, int) or isinstance(order, bool) or order < 1):
+            problems.add(f"{where}.order", f"expected a positive integer, found {order!r}")
+        memory = (problems.number(table, "memory_length", f"{where}.memory_length", positive=True)
+                  if "memory_length" in table else None)
+        if path is None or name is None or method is None:
+            continue
+        try:
+            decks = read_couplings(path, bodies=known)
+        except InputError as exc:
+            problems.add(f"{where}.deck", str(exc))
+            continue
+        if name not in decks:
+            problems.add(f"{where}.coupling", f"{name!r} is not in {path.name} (it has: {', '.join(decks) or 'none'})")
+            continue
+        d = decks[name]
+        a, b = mapping.get(d.body_a, d.body_a), mapping.get(d.body_b, d.body_b)
+        for side, body in (("A", a), ("B", b)):
+            if body not in bodies:
+                problems.add(f"{where}.bodies", f"CHBDY_{side} {body!r} of {name} is not a scene body: map it, "
+                                                f"e.g. bodies = {{ {body} = \"{next(iter(bodies), 'name')}\" }}")
+        if not identifier(name) or name in names:
+            problems.add(f"{where}.coupling", f"coupling names must be distinct identifiers, found {name!r}")
+        names.add(name)
+        out.append(Coupling(name, a, b, {
+            "added_mass": np.asarray(d.added_mass, float).tolist(),
+            "timdel": d.timdel,
+            "kernels": [[i_, j_, np.asarray(h, float).tolist()] for (i_, j_), h in d.kernels.items()],
+        }, method, tol, order, memory))
+    return out
+
+
 JOINT_KEYS = {"type", "a", "a_point", "b", "b_point", "stiffness", "damping", "rot_stiffness",
               "rot_damping", "acceleration_loads"}
 
@@ -454,8 +527,9 @@ def load_scene(path):
         joint = _joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
+    couplings = _couplings(p, doc["couplings"], bodies) if "couplings" in doc else []
     scene = Scene(
-        name=name, path=path, joints=joints,
+        name=name, path=path, joints=joints, couplings=couplings,
         rho=p.number(env, "rho", "environment.rho", 1025.0, positive=True),
         g=p.number(env, "g", "environment.g", 9.81, positive=True),
         current_speed=p.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),

@@ -78,6 +78,64 @@ def exported_mass(scene):
         node = joint_node(joint)
         if joint.accel_mode == "export" and node.uses_acceleration:
             out[joint.a] = out[joint.a] + node.mass_matrix(initial_motion(scene.bodies[joint.a]))
+    for target, source, mass, _ in coupling_sides(scene.couplings):
+        if target == source and scene.bodies[target].accel_mode == "export":
+            out[target] = out[target] + mass
+    return out
+
+
+def coupling_sides(couplings):
+    """(target body, source body, 6×6 mass block, side) of every coupling side: side A is
+    the load on a from b's motion (A∞), side B the load on b from a's motion (A∞ᵀ)."""
+    out = []
+    for c in couplings:
+        am = np.array(c.data["added_mass"], dtype=float)
+        out.append((c.a, c.b, am, "A"))
+        if c.a != c.b:
+            out.append((c.b, c.a, am.T, "B"))
+    return out
+
+
+def dynamics_groups(scene):
+    """Bodies coupled by cross-body added mass in export mode share one dynamics FMU.
+    Returns {body: (instance, variable prefix)} and [(instance, [bodies])]."""
+    parent = {b: b for b in scene.bodies}
+
+    def root(b):
+        while parent[b] != b:
+            b = parent[b]
+        return b
+    for target, source, mass, _ in coupling_sides(scene.couplings):
+        if target != source and scene.bodies[target].accel_mode == "export" and np.any(mass):
+            parent[root(target)] = root(source)
+    groups = {}
+    for b in scene.bodies:
+        groups.setdefault(root(b), []).append(b)
+    dyn_of, out = {}, []
+    for members in groups.values():
+        instance = f"{'_'.join(members)}_dynamics"
+        out.append((instance, members))
+        for b in members:
+            dyn_of[b] = (instance, f"{b}." if len(members) > 1 else "")
+    return dyn_of, out
+
+
+def rigid_mass(body, added):
+    return RigidBody(body.mass, body.inertia, body.cog, added_mass=added, attitude0=body.attitude).mass_matrix()
+
+
+def stability_indicators(scene, exported):
+    """Spectral radius ρ[(M_A+A_AA)⁻¹·A_AB·(M_B+A_BB)⁻¹·A_BA] of every cross coupling:
+    explicit (staggered) coupling of the cross added mass diverges when ρ ≥ 1."""
+    from ..physics.coupling import stability_indicator
+    out = {}
+    for c in scene.couplings:
+        if c.a == c.b:
+            continue
+        a, b = scene.bodies[c.a], scene.bodies[c.b]
+        am = np.array(c.data["added_mass"], dtype=float)
+        out[c.name] = float(stability_indicator(rigid_mass(a, np.zeros((6, 6))), exported[c.a], am,
+                                                rigid_mass(b, np.zeros((6, 6))), exported[c.b], am.T))
     return out
 
 
@@ -98,9 +156,7 @@ def joint_config(scene, joint, exported):
         point_b = rotation(b.attitude).T @ (point_a_world - np.array(b.position))
 
     def effective(body, point):
-        mass6 = RigidBody(body.mass, body.inertia, body.cog, added_mass=exported[body.name],
-                          attitude0=body.attitude).mass_matrix()
-        return conb.effective_mass(mass6, rotation(body.attitude) @ point)
+        return conb.effective_mass(rigid_mass(body, exported[body.name]), rotation(body.attitude) @ point)
 
     m_a, i_a = effective(a, np.array(joint.a_point))
     m_b, i_b = effective(b, point_b) if b is not None else (None, None)
@@ -120,47 +176,68 @@ def joint_config(scene, joint, exported):
 def fmu_specs(scene):
     """What to build: one dict per FMU instance, in Gauss–Seidel order (load and joint
     FMUs first, so that every FMU steps from t_k with inputs that are values at t_k).
-    ``motion``: input prefix -> dynamics instance it reads; ``forces``: (output group,
-    dynamics instance, input group) routes."""
+    ``motion``: input prefix -> body whose dynamics outputs feed it; ``forces``: (output
+    group, body, input group) routes to that body's dynamics."""
     env = {"rho": scene.rho, "g": scene.g, "current_speed": scene.current_speed,
            "current_direction": scene.current_direction}
     exported = exported_mass(scene)
+    dyn_of, groups = dynamics_groups(scene)
+    sides = coupling_sides(scene.couplings)
     loads_specs, joint_specs, dyn_specs = [], [], []
-    for body in scene.bodies.values():
-        dyn = f"{body.name}_dynamics"
-        sources = [""] + [j.name for j in scene.joints.values() if body.name in (j.a, j.b)]
-        dyn_specs.append({
-            "instance": dyn, "model_id": f"{scene.name}_{body.name}_dynamics",
-            "slave": "DynamicsSlave", "kind": "dynamics", "body": body.name, "motion": {}, "forces": [],
-            "config": {
-                "description": f"6-DOF rigid-body dynamics of '{body.name}' (scene {scene.name})",
-                "mass": body.mass, "inertia": body.inertia, "cog": body.cog,
+    for instance, members in groups:
+        bodies = []
+        for name in members:
+            body = scene.bodies[name]
+            bodies.append({
+                "name": name, "mass": body.mass, "inertia": body.inertia, "cog": body.cog,
                 "stiffness": body.stiffness, "damping": body.damping,
                 "position": body.position, "attitude": body.attitude, "velocity": body.velocity,
-                "substep": scene.run["substep"], "load_sources": sources,
-                "added_mass": exported[body.name].tolist(),
+                "load_sources": [""] + [j.name for j in scene.joints.values() if name in (j.a, j.b)],
+                "added_mass": exported[name].tolist(),
+            })
+        cross = [[t, src, m.tolist()] for t, src, m, _ in sides
+                 if t != src and t in members and src in members and scene.bodies[t].accel_mode == "export"]
+        dyn_specs.append({
+            "instance": instance, "model_id": f"{scene.name}_{instance}",
+            "slave": "DynamicsSlave", "kind": "dynamics", "body": members[0], "motion": {}, "forces": [],
+            "config": {
+                "description": f"6-DOF rigid-body dynamics of {', '.join(members)} (scene {scene.name})",
+                "bodies": bodies, "cross": cross, "substep": scene.run["substep"],
             },
         })
+    for body in scene.bodies.values():
+        couplings, motion = [], {"": body.name}
+        for c in scene.couplings:
+            for target, source, mass, side in coupling_sides([c]):
+                if target != body.name:
+                    continue
+                couplings.append({"name": c.name, "side": side, "source": source, "self": source == target,
+                                  "mass": mass.tolist(), "data": c.data, "method": c.method,
+                                  "tolerance": c.tolerance, "order": c.order, "memory_length": c.memory_length})
+                if source != target:
+                    motion[f"{source}."] = source
         loads_specs.append({
             "instance": body.name, "model_id": f"{scene.name}_{body.name}",
             "slave": "LoadSlave", "kind": "load", "body": body.name,
-            "motion": {"": dyn}, "forces": [("force", dyn, "force")],
+            "motion": motion, "forces": [("force", body.name, "force")],
             "config": {
                 "description": f"hydrodynamic loads on '{body.name}' (scene {scene.name}): "
-                               + (", ".join(f"{e.name} ({e.type})" for e in body.effects) or "no effects"),
+                               + (", ".join([f"{e.name} ({e.type})" for e in body.effects]
+                                            + [f"{c['name']} (simo_coupling)" for c in couplings]) or "no effects"),
                 "body": body.name, "position": body.position, "attitude": body.attitude,
                 "accel_mode": body.accel_mode,
                 "effects": [{"type": e.type, "name": e.name, "data": e.data} for e in body.effects],
+                "couplings": couplings,
                 **env,
             },
         })
     for joint in scene.joints.values():
         a, b = scene.bodies[joint.a], scene.bodies.get(joint.b)
-        motion = {"A.": f"{a.name}_dynamics"}
-        forces = [("A.force", f"{a.name}_dynamics", f"{joint.name}.force")]
+        motion = {"A.": a.name}
+        forces = [("A.force", a.name, f"{joint.name}.force")]
         if b is not None:
-            motion["B."] = f"{b.name}_dynamics"
-            forces.append(("B.force", f"{b.name}_dynamics", f"{joint.name}.force"))
+            motion["B."] = b.name
+            forces.append(("B.force", b.name, f"{joint.name}.force"))
         joint_specs.append({
             "instance": joint.name, "model_id": f"{scene.name}_{joint.name}",
             "slave": "ConnectorSlave", "kind": "joint", "body": a.name, "motion": motion, "forces": forces,
@@ -175,7 +252,7 @@ def fmu_specs(scene):
                 **env,
             },
         })
-    return loads_specs + joint_specs + dyn_specs
+    return loads_specs + joint_specs + dyn_specs, dyn_of
 
 
 def build_fmu(spec, workdir, runtime, shim=True):
@@ -219,19 +296,21 @@ def rewrite_model_description(fmu, slave):
     tmp.replace(fmu)
 
 
-def connections(specs, slaves):
+def connections(specs, slaves, dyn_of):
     """Motion outputs of the dynamics FMUs → the motion inputs that exist (by name), and
     load outputs → the dynamics' load inputs, as each spec's routes say."""
     names = {s["instance"]: {v.name for v in slaves[s["instance"]].vars.values()} for s in specs}
     conns = []
     for s in specs:
-        for prefix, dyn in s["motion"].items():
+        for prefix, body in s["motion"].items():
+            dyn, dp = dyn_of[body]
             for group, n in (("position", 3), ("attitude", 3), ("velocity", 6), ("acceleration", 6)):
                 for i in range(1, n + 1):
                     if f"{prefix}{group}[{i}]" in names[s["instance"]]:
-                        conns.append([dyn, f"{group}[{i}]", s["instance"], f"{prefix}{group}[{i}]"])
-        for out, dyn, inp in s["forces"]:
-            conns += [[s["instance"], f"{out}[{i}]", dyn, f"{inp}[{i}]"] for i in range(1, 7)]
+                        conns.append([dyn, f"{dp}{group}[{i}]", s["instance"], f"{prefix}{group}[{i}]"])
+        for out, body, inp in s["forces"]:
+            dyn, dp = dyn_of[body]
+            conns += [[s["instance"], f"{out}[{i}]", dyn, f"{dp}{inp}[{i}]"] for i in range(1, 7)]
     return conns
 
 
@@ -253,13 +332,37 @@ def osp_system_structure(scene, specs, conns):
     return minidom.parseString(ET.tostring(root, encoding="unicode")).toprettyxml(indent="  ")
 
 
+def report_fits(scene, log):
+    """State-space couplings: fitted order and error of every kernel, at build time."""
+    from types import SimpleNamespace
+    from ..physics.coupling import Coupling
+    for c in scene.couplings:
+        if c.method != "state_space" or not c.data["kernels"]:
+            continue
+        data = SimpleNamespace(name=c.name, body_a=c.a, body_b=c.b, added_mass=c.data["added_mass"],
+                               timdel=c.data["timdel"], kernels={(i, j): h for i, j, h in c.data["kernels"]})
+        model = Coupling(data, "state_space", c.tolerance, c.order, c.memory_length)
+        worst = max(f.error for f in model.fits.values())
+        log(f"coupling {c.name}: state-space orders "
+            + ", ".join(f"{i}{j}:{f.order}" for (i, j), f in sorted(model.fits.items()))
+            + f"; worst fit error {100 * worst:.2f} % (normalised RMS)")
+
+
 def build_scene(scene, outdir, shim=True, log=print):
     """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
     The folder is replaced only when the whole build succeeded."""
     outdir = Path(outdir)
     target = outdir / scene.name
-    specs = fmu_specs(scene)
+    specs, dyn_of = fmu_specs(scene)
     runtime = runtime_name()
+    indicators = stability_indicators(scene, exported_mass(scene))
+    for name, rho in indicators.items():
+        c = next(c for c in scene.couplings if c.name == name)
+        explicit = "explicit" in (scene.bodies[c.a].accel_mode, scene.bodies[c.b].accel_mode)
+        log(f"coupling {name}: staggered-coupling indicator ρ = {rho:.3g}"
+            + (" — WARNING: explicit coupling of the cross added mass will diverge (ρ ≥ 1); use export mode"
+               if explicit and rho >= 1 else ""))
+    report_fits(scene, log)
     outdir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f".{scene.name}-", dir=outdir) as tmp:
         work = Path(tmp)
@@ -267,12 +370,14 @@ def build_scene(scene, outdir, shim=True, log=print):
         for spec in specs:
             fmu, slaves[spec["instance"]] = build_fmu(spec, work, runtime, shim)
             log(f"built {fmu.name}")
-        conns = connections(specs, slaves)
+        conns = connections(specs, slaves, dyn_of)
         result = work / "fmus"
         manifest = {
             "scene": scene.name, "source": str(scene.path), "run": scene.run,
             "instances": {s["instance"]: {"fmu": f"{s['model_id']}.fmu", "kind": s["kind"], "body": s["body"]}
                           for s in specs},
+            "dynamics": {body: list(v) for body, v in dyn_of.items()},
+            "stability_indicators": indicators,
             "order": [s["instance"] for s in specs],
             "connections": conns,
         }

@@ -17,10 +17,13 @@ import numpy as np
 from pythonfmu import Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
+from types import SimpleNamespace
+
+from ..physics.coupling import Coupling
 from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
-from ..physics.rigid_body import RigidBody
+from ..physics.rigid_body import CoupledBodies, RigidBody
 from ..physics.state import Env, Motion
 
 CONFIG = "hydrofmu.json"
@@ -102,15 +105,19 @@ class ArraySlave(Fmi2Slave):
         self.g = self.add("g", Fmi2Causality.parameter, "m/s2", cfg["g"], "acceleration of gravity")
         return [self.current] if self.current else []
 
-    def add_mass_export(self, name, matrix):
-        """Calculated parameters name[i,j]: a 6×6 mass contribution for the dynamics side."""
+    def add_matrix(self, name, causality, matrix, description):
         first = len(self._start)
+        matrix = np.asarray(matrix, dtype=float)
         for i in range(6):
             for j in range(6):
-                self.add(f"{name}[{i + 1},{j + 1}]", Fmi2Causality.calculatedParameter, MASS_UNITS[i][j],
-                         matrix[i, j], "exported added/point mass about the reference point, global axes "
-                                       "(row = load dof)" if i == j == 0 else None)
+                self.add(f"{name}[{i + 1},{j + 1}]", causality, MASS_UNITS[i][j], matrix[i, j],
+                         description if i == j == 0 else None)
         return slice(first, first + 36)
+
+    def add_mass_export(self, name, matrix):
+        """Calculated parameters name[i,j]: a 6×6 mass contribution for the dynamics side."""
+        return self.add_matrix(name, Fmi2Causality.calculatedParameter, matrix,
+                               "exported added/point mass about the reference point, global axes (row = load dof)")
 
     def motion(self, slices, values=None):
         v = self.values if values is None else values
@@ -198,22 +205,62 @@ class LoadSlave(ArraySlave):
         cfg = self.config
         explicit = cfg["accel_mode"] == "explicit"
         self.loads = BodyLoads([make_effect(e["type"], e["name"], e["data"]) for e in cfg["effects"]], explicit)
-        Out = Fmi2Causality.output
-        self.motion_inputs = self.add_motion("", cfg["position"], cfg["attitude"],
-                                             explicit and self.loads.uses_acceleration)
+        Out, In = Fmi2Causality.output, Fmi2Causality.input
+        couplings = cfg.get("couplings", [])
+        own_acc = explicit and (self.loads.uses_acceleration or any(c["self"] for c in couplings))
+        self.motion_inputs = self.add_motion("", cfg["position"], cfg["attitude"], own_acc)
         inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
+        # hydrodynamic couplings: the source body's velocity (and acceleration) in
+        self.couplings = []
+        for c in couplings:
+            src = c["source"]
+            vel = self.motion_inputs[2] if c["self"] else self.add_vector(
+                f"{src}.velocity", 6, In, LIN_ROT["velocity"], None, f"velocity of coupled body {src}, global")
+            acc = None
+            if explicit:
+                acc = self.motion_inputs[3] if c["self"] else self.add_vector(
+                    f"{src}.acceleration", 6, In, LIN_ROT["acceleration"], None,
+                    f"acceleration of coupled body {src}, global")
+            out = self.add_vector(f"{c['name']}.force", 6, Out, LIN_ROT["force"], None,
+                                  f"hydrodynamic coupling {c['name']} (from {src}'s motion)")
+            self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out})
+            inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
         self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
                                      "total load on the body, global axes, moments about the reference point")
         self.effect_force = [self.add_vector(f"{e.name}.force", 6, Out, LIN_ROT["force"], None,
                                              f"load of effect {e.name}")
                              for e in self.loads.effects]
-        self.depends([self.force] + self.effect_force, inputs)
+        self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
         # export mode: the mass contribution of acceleration loads, for the dynamics side
         if self.loads.uses_acceleration and not explicit:
             self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
                                                                                    np.array(self._start))))
+        if not explicit:
+            for c in self.couplings:
+                self.add_mass_export(f"{c['cfg']['name']}.mass_matrix", np.asarray(c["cfg"]["mass"]))
         self.finish_registration()
+        self.time = 0.0
+        self.stale = True
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.time = start_time
+
+    def exit_initialization_mode(self):
+        for c in self.couplings:
+            cfg = c["cfg"]
+            d = cfg["data"]
+            v0 = self.values[c["velocity"]].copy()
+            data = SimpleNamespace(name=cfg["name"], body_a="A", body_b="A" if cfg["self"] else "B",
+                                   added_mass=d["added_mass"], timdel=d["timdel"],
+                                   kernels={(i, j): np.asarray(h) for i, j, h in d["kernels"]})
+            c["mass"] = np.asarray(cfg["mass"])
+            c["memory"] = None
+            if d["kernels"]:
+                model = Coupling(data, cfg["method"], cfg["tolerance"], cfg["order"], cfg["memory_length"],
+                                 v0_a=v0, v0_b=v0)
+                c["memory"] = FeedthroughMemory(model.memory[cfg["side"] if not cfg["self"] else "A"],
+                                                self.time)
         self.stale = True
 
     def evaluate(self):
@@ -221,64 +268,111 @@ class LoadSlave(ArraySlave):
         if not self.check_finite(self.inputs):
             return
         per_effect = self.loads.effect_loads(self.motion(self.motion_inputs), self.env())
+        total = per_effect.sum(axis=0)
         for s, load in zip(self.effect_force, per_effect):
             self.values[s] = load
-        self.values[self.force] = per_effect.sum(axis=0)
+        for c in self.couplings:
+            load = np.zeros(6)
+            if c.get("memory") is not None:
+                load = c["memory"].force(self.time, self.values[c["velocity"]])
+            if c["acceleration"] is not None:
+                load = load - c["mass"] @ self.values[c["acceleration"]]
+            self.values[c["force"]] = load
+            total = total + load
+        self.values[self.force] = total
+
+    def advance(self, t, dt):
+        for c in self.couplings:
+            if c.get("memory") is not None:
+                c["memory"].commit(t, self.values[c["velocity"]])
+        self.time = t + dt
+        self.stale = bool(self.couplings)  # memory outputs move with time
+
+    def physics_state(self):
+        return {"time": self.time,
+                "memory": [None if c.get("memory") is None else c["memory"].state() for c in self.couplings]}
+
+    def set_physics_state(self, state):
+        self.time = state["time"]
+        for c, s in zip(self.couplings, state["memory"]):
+            if s is not None:
+                c["memory"].set_state(s)
 
 
 class DynamicsSlave(ArraySlave):
-    """6-DOF rigid body (the dynamics partner): load inputs in, motion out."""
+    """6-DOF rigid-body dynamics (the dynamics partner): load inputs in, motion out.
+
+    One FMU integrates one body, or a group of bodies coupled by cross-body added mass
+    (then every variable is prefixed by the body name and the cross blocks are parameters
+    ``<i>.<j>.added_mass[r,c]``: load on i from the acceleration of j)."""
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         cfg = self.config
         In, Out, Par = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
-        self.load_inputs = [self.add_vector(f"{src}.force" if src else "force", 6, In, LIN_ROT["force"], None,
-                                            f"load from {src or 'the body FMU'}, global axes, about the reference point")
-                            for src in cfg["load_sources"]]
-        added = np.asarray(cfg["added_mass"], dtype=float)
-        self.added_mass = slice(len(self._start), len(self._start) + 36)
-        for i in range(6):
-            for j in range(6):
-                self.add(f"added_mass[{i + 1},{j + 1}]", Par, MASS_UNITS[i][j], added[i, j],
-                         "mass contributions exported by load FMUs, global axes" if i == j == 0 else None)
-        self.position = self.add_vector("position", 3, Out, "m", cfg["position"])
-        self.attitude = self.add_vector("attitude", 3, Out, "rad", cfg["attitude"])
-        self.velocity = self.add_vector("velocity", 6, Out, LIN_ROT["velocity"], cfg["velocity"])
-        self.acceleration = self.add_vector("acceleration", 6, Out, LIN_ROT["acceleration"], None)
-        self.depends([self.position, self.attitude, self.velocity, self.acceleration], [])
+        group = len(cfg["bodies"]) > 1
+        self.parts = []
+        for b in cfg["bodies"]:
+            p = f"{b['name']}." if group else ""
+            part = {"cfg": b}
+            part["loads"] = [self.add_vector(f"{p}{src}.force" if src else f"{p}force", 6, In, LIN_ROT["force"],
+                                             None, f"load from {src or 'the body FMU'}, global axes, "
+                                                   "about the reference point")
+                             for src in b["load_sources"]]
+            part["added"] = self.add_matrix(f"{p}added_mass", Par, b["added_mass"],
+                                            "mass contributions exported by load FMUs, global axes")
+            part["position"] = self.add_vector(f"{p}position", 3, Out, "m", b["position"])
+            part["attitude"] = self.add_vector(f"{p}attitude", 3, Out, "rad", b["attitude"])
+            part["velocity"] = self.add_vector(f"{p}velocity", 6, Out, LIN_ROT["velocity"], b["velocity"])
+            part["acceleration"] = self.add_vector(f"{p}acceleration", 6, Out, LIN_ROT["acceleration"], None)
+            self.depends([part[k] for k in ("position", "attitude", "velocity", "acceleration")], [])
+            self.parts.append(part)
+        names = [b["name"] for b in cfg["bodies"]]
+        self.cross = {(names.index(a), names.index(b)): self.add_matrix(
+                          f"{a}.{b}.added_mass", Par, m, f"cross added mass: load on {a} from {b}'s acceleration")
+                      for a, b, m in cfg.get("cross", [])}
+        self.load_inputs = [s for part in self.parts for s in part["loads"]]
         self.finish_registration()
-        self.body = None
+        self.solver = None
         self.stale = False
 
     def exit_initialization_mode(self):
-        cfg = self.config
         v = self.values
-        self.body = RigidBody(
-            mass=cfg["mass"], inertia=np.asarray(cfg["inertia"]), cog=np.asarray(cfg["cog"]),
-            stiffness=np.asarray(cfg["stiffness"]), damping=np.asarray(cfg["damping"]),
-            added_mass=v[self.added_mass].reshape(6, 6).copy(),
-            position0=v[self.position].copy(), attitude0=v[self.attitude].copy(),
-            velocity0=v[self.velocity].copy(), max_substep=cfg["substep"])
-
-    def total_load(self):
-        return sum(self.values[s] for s in self.load_inputs)
+        bodies = []
+        for part in self.parts:
+            b = part["cfg"]
+            bodies.append(RigidBody(
+                mass=b["mass"], inertia=np.asarray(b["inertia"]), cog=np.asarray(b["cog"]),
+                stiffness=np.asarray(b["stiffness"]), damping=np.asarray(b["damping"]),
+                added_mass=v[part["added"]].reshape(6, 6).copy(),
+                position0=v[part["position"]].copy(), attitude0=v[part["attitude"]].copy(),
+                velocity0=v[part["velocity"]].copy(), max_substep=self.config["substep"]))
+        self.bodies = bodies
+        if self.cross:
+            self.solver = CoupledBodies(bodies, {k: v[s].reshape(6, 6).copy() for k, s in self.cross.items()})
 
     def advance(self, t, dt):
         if not self.check_finite(self.load_inputs):
             return
-        body = self.body
-        body.step(dt, self.total_load())
+        loads = [sum(self.values[s] for s in part["loads"]) for part in self.parts]
+        if self.solver is not None:
+            self.solver.step(dt, loads)
+            accelerations = self.solver.accelerations()
+        else:
+            self.bodies[0].step(dt, loads[0])
+            accelerations = [self.bodies[0].acceleration]
         v = self.values
-        v[self.position], v[self.attitude] = body.position, body.attitude
-        v[self.velocity], v[self.acceleration] = body.velocity, body.acceleration
+        for part, body, acc in zip(self.parts, self.bodies, accelerations):
+            v[part["position"]], v[part["attitude"]] = body.position, body.attitude
+            v[part["velocity"]], v[part["acceleration"]] = body.velocity, acc
 
     def physics_state(self):
-        return None if self.body is None else _plain(self.body.state())
+        return None if not hasattr(self, "bodies") else [_plain(b.state()) for b in self.bodies]
 
     def set_physics_state(self, state):
         if state is not None:
-            self.body.set_state(state)
+            for body, s in zip(self.bodies, state):
+                body.set_state(s)
 
 
 class ConnectorSlave(ArraySlave):
@@ -328,6 +422,44 @@ class ConnectorSlave(ArraySlave):
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
         v[self.gap], v[self.rotation] = self.joint.deformation(a, b)
+
+
+class FeedthroughMemory:
+    """A retardation-memory evaluator seen through FMI: its output follows the current
+    input before the step commits it.  The pending interval [t_commit, t] (velocity
+    linear, ending at the current input) is evaluated on a copy of the state; ``commit``
+    keeps that result when the step confirms the same interval."""
+
+    def __init__(self, evaluator, t0):
+        self.ev, self.t, self._peek = evaluator, t0, None
+
+    def force(self, t, v):
+        dt = t - self.t
+        if dt <= 0.0:
+            return np.asarray(self.ev.force, dtype=float).copy()
+        saved = self.ev.state()
+        f = np.asarray(self.ev.advance(dt, v), dtype=float).copy()
+        self._peek = (dt, np.array(v, dtype=float), self.ev.state())
+        self.ev.set_state(saved)
+        return f
+
+    def commit(self, t, v):
+        dt = t - self.t
+        if dt <= 0.0:
+            return
+        peek = self._peek
+        if peek is not None and peek[0] == dt and np.array_equal(peek[1], v):
+            self.ev.set_state(peek[2])
+        else:
+            self.ev.advance(dt, v)
+        self.t, self._peek = t, None
+
+    def state(self):
+        return {"t": self.t, "ev": self.ev.state()}
+
+    def set_state(self, state):
+        self.t, self._peek = state["t"], None
+        self.ev.set_state(state["ev"])
 
 
 def _plain(obj):

@@ -178,12 +178,15 @@ class RigidBody:
         bias = np.concatenate([self.mass * (w @ (w @ (rot @ self.cog))), w @ (mrb[3:, 3:] @ omega)])
         return mrb + self._added_mass, bias
 
-    def _accel(self, y, load):
+    def _system(self, y, load):
+        """(M_rb + A, right-hand side) of the equations of motion at state y."""
         eta, nu = y[:6], y[6:]
         mtot, bias = self._mass_and_bias(eta[3:], nu[3:])
-        rhs = load - self.stiffness @ (eta - self.eta0) - self.damping @ nu - bias
+        return mtot, load - self.stiffness @ (eta - self.eta0) - self.damping @ nu - bias
+
+    def _accel(self, y, load):
         try:
-            return np.linalg.solve(mtot, rhs)
+            return np.linalg.solve(*self._system(y, load))
         except np.linalg.LinAlgError:
             raise self._error("added_mass", "mass matrix M_rb + A is singular") from None
 
@@ -254,3 +257,58 @@ class RigidBody:
         if abs(math.cos(s[4])) < GIMBAL_TOL:
             raise GimbalLockError(_gimbal_message(s[3:6]))
         self._y, self._load = s[:12].copy(), s[12:].copy()
+
+
+class CoupledBodies:
+    """Rigid bodies whose accelerations are coupled by cross-body added mass (SIMO coupled
+    A∞ in ``export`` mode: the dynamics side holds it in its mass matrix).
+
+    ``bodies``: RigidBody objects (their own added mass on the diagonal); ``cross``:
+    {(i, j): 6×6} global, the load on body i is −cross[i, j]·a_j.  Equations:
+    [[M_1+A_11, A_12, …], [A_21, M_2+A_22, …], …]·[a_1; a_2; …] = [rhs_1; rhs_2; …],
+    integrated with RK4 in equal substeps (the smallest max_substep of the bodies).
+    """
+
+    def __init__(self, bodies, cross):
+        self.bodies = list(bodies)
+        self.cross = {k: np.asarray(v, dtype=float) for k, v in cross.items()}
+        self.max_substep = min(b.max_substep for b in self.bodies)
+
+    def _solve(self, ys, loads):
+        n = len(self.bodies)
+        big, rhs = np.zeros((6 * n, 6 * n)), np.zeros(6 * n)
+        for i, (b, y, load) in enumerate(zip(self.bodies, ys, loads)):
+            big[6 * i:6 * i + 6, 6 * i:6 * i + 6], rhs[6 * i:6 * i + 6] = b._system(y, load)
+        for (i, j), m in self.cross.items():
+            big[6 * i:6 * i + 6, 6 * j:6 * j + 6] += m
+        return np.linalg.solve(big, rhs).reshape(n, 6)
+
+    def _deriv(self, ys, loads):
+        acc = self._solve(ys, loads)
+        out = []
+        for y, a in zip(ys, acc):
+            ct = math.cos(y[4])
+            if abs(ct) < GIMBAL_TOL:
+                raise GimbalLockError(_gimbal_message(y[3:6]))
+            out.append(np.concatenate([y[6:9], _euler_rates(y[4], y[5], ct, y[9:]), a]))
+        return np.array(out)
+
+    def step(self, dt, loads):
+        """Advance all bodies by dt [s] with their external loads (list of (6,)) held."""
+        loads = [np.asarray(l, dtype=float) for l in loads]
+        ys = np.array([b._y for b in self.bodies])
+        if dt > 0.0:
+            n = max(1, math.ceil(dt / self.max_substep * (1.0 - 1e-12)))
+            h = dt / n
+            for _ in range(n):
+                k1 = self._deriv(ys, loads)
+                k2 = self._deriv(ys + 0.5 * h * k1, loads)
+                k3 = self._deriv(ys + 0.5 * h * k2, loads)
+                k4 = self._deriv(ys + h * k3, loads)
+                ys = ys + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for b, y, load in zip(self.bodies, ys, loads):
+            b._y, b._load = y, load
+
+    def accelerations(self):
+        """(n, 6) accelerations from the current states and the last held loads."""
+        return self._solve([b._y for b in self.bodies], [b._load for b in self.bodies])
