@@ -429,7 +429,7 @@ def _joint(problems, name, table, where, bodies):
 
 BODY_KEYS = {"position", "attitude", "velocity", "mass", "inertia", "cog", "stiffness", "damping",
              "acceleration_loads", "effects"}
-RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01}
+RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "constant"}
 
 
 def _body(problems, name, table, where):
@@ -508,6 +508,7 @@ def load_scene(path):
         "algorithm": p.choice(run, "algorithm", "run.algorithm", ("jacobi", "gauss-seidel"),
                               RUN_DEFAULTS["algorithm"]),
         "substep": p.number(run, "substep", "run.substep", RUN_DEFAULTS["substep"], positive=True),
+        "load_hold": p.choice(run, "load_hold", "run.load_hold", ("constant", "linear"), "constant"),
     }
     bodies_t = p.table(doc, "bodies", "bodies") or {}
     bodies = {}

@@ -60,7 +60,7 @@ def run(folder, stop=None, step=None, record=None):
     for j, col in enumerate(record):
         name, var = col.split(".", 1)
         values[:, j] = _samples(series, index[name], refs[name][var], n)
-    return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step)
+    return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step, manifest["dynamics"])
 
 
 def _samples(series, slave, ref, n):

@@ -5,9 +5,10 @@ Algorithms (communication step h, points t_k = k·h):
 - ``jacobi``: all FMUs step from t_k with the inputs set at t_k; then every output is
   read and every input set, as libcosim's fixed-step algorithm does.  A load therefore
   reaches the dynamics one step late: F(x_{k-1}) acts over [t_k, t_{k+1}].
-- ``gauss-seidel``: FMUs step one after the other in the manifest's order (load FMUs
-  before the dynamics); each one's inputs are set from the latest outputs just before
-  it steps.  Load FMUs are direct feedthrough, so F(x_k) acts over [t_k, t_{k+1}].
+- ``gauss-seidel``: at t_k the inputs are set in the manifest's order (load FMUs before
+  the dynamics), each from the latest outputs; load FMUs are direct feedthrough, so the
+  dynamics receive F(x_k, t_k) — loads evaluated with the motion at t_k — and F(x_k)
+  acts over [t_k, t_{k+1}]; then every FMU steps.
 
 Initialisation resolves the feedthrough: connections are transferred twice inside
 initialization mode, so at t = 0 every load output reflects the initial motion.
@@ -32,6 +33,7 @@ class Result:
     values: np.ndarray
     algorithm: str
     step: float
+    dynamics: dict = None  # body -> [dynamics instance, variable prefix]
 
     def __getitem__(self, column):
         return self.values[:, self.columns.index(column)]
@@ -39,6 +41,12 @@ class Result:
     def vector(self, instance, name, n):
         """(n_times, n) array of instance.name[1..n]."""
         return np.column_stack([self[f"{instance}.{name}[{i}]"] for i in range(1, n + 1)])
+
+    def motion(self, body, name, n):
+        """(n_times, n) array of a body's dynamics output name[1..n] (position, attitude,
+        velocity, acceleration), wherever the body's dynamics FMU is."""
+        instance, prefix = self.dynamics[body]
+        return self.vector(instance, f"{prefix}{name}", n)
 
     def to_csv(self, path):
         with open(path, "w", newline="") as f:
@@ -103,6 +111,13 @@ class System:
         for dst, dvr, values in batch:
             self.instances[dst].fmu.setReal(dvr, values)
 
+    def resolve(self, order):
+        """Set every FMU's inputs, in ``order``, from the latest outputs: with load FMUs
+        (direct feedthrough) before the dynamics, each load output then reflects the
+        dynamics' state at this communication point."""
+        for inst in order:
+            self.transfer(targets={inst.name})
+
     def initialize(self, start=0.0):
         for inst in self.instances.values():
             inst.fmu.setupExperiment(startTime=start)
@@ -157,6 +172,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 values[k, cols] = fmu.getReal(vrs)
 
         system.initialize()
+        if algorithm != "jacobi":
+            system.resolve([system.instances[name] for name in system.order])
         sample(0)
         t0 = clock.perf_counter()
         order = [system.instances[name] for name in system.order]
@@ -169,8 +186,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 system.transfer()
             else:
                 for inst in order:
-                    system.transfer(targets={inst.name})
                     inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+                system.resolve(order)
                 sample(k + 1)
             if progress and (k + 1) % every == 0:
                 elapsed = clock.perf_counter() - t0
@@ -180,6 +197,6 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 sys.stderr.flush()
         if progress and tty:
             sys.stderr.write("\n")
-        return Result(np.arange(n + 1) * step, list(record), values, algorithm, step)
+        return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"])
     finally:
         system.free()

@@ -10,13 +10,13 @@ def plot(result, manifest, path):
     import matplotlib.pyplot as plt
     import numpy as np
 
-    bodies = sorted({v["body"] for v in manifest["instances"].values()})
+    bodies = sorted(manifest["dynamics"])
     fig, axes = plt.subplots(len(bodies), 3, figsize=(15, 3.6 * len(bodies)), squeeze=False)
     t = result.time
     for row, body in zip(axes, bodies):
-        dyn, load = f"{body}_dynamics", body
-        pos = result.vector(dyn, "position", 3)
-        att = np.degrees(result.vector(dyn, "attitude", 3))
+        load = body
+        pos = result.motion(body, "position", 3)
+        att = np.degrees(result.motion(body, "attitude", 3))
         for i, label in enumerate(("x", "y", "z")):
             row[0].plot(t, pos[:, i], label=label)
         row[0].set(title=f"{body}: position [m]", xlabel="time [s]")

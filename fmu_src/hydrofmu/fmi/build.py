@@ -203,6 +203,7 @@ def fmu_specs(scene):
             "config": {
                 "description": f"6-DOF rigid-body dynamics of {', '.join(members)} (scene {scene.name})",
                 "bodies": bodies, "cross": cross, "substep": scene.run["substep"],
+                "load_hold": scene.run["load_hold"],
             },
         })
     for body in scene.bodies.values():

@@ -354,12 +354,18 @@ class DynamicsSlave(ArraySlave):
     def advance(self, t, dt):
         if not self.check_finite(self.load_inputs):
             return
-        loads = [sum(self.values[s] for s in part["loads"]) for part in self.parts]
+        loads = np.array([sum(self.values[s] for s in part["loads"]) for part in self.parts])
+        rates = None
+        if self.config.get("load_hold") == "linear":
+            # first-order hold: extrapolate the load with its slope over the last step
+            last = getattr(self, "last_loads", None)
+            rates = np.zeros_like(loads) if last is None else (loads - last[0]) / last[1]
+            self.last_loads = (loads, dt)
         if self.solver is not None:
-            self.solver.step(dt, loads)
+            self.solver.step(dt, loads, rates)
             accelerations = self.solver.accelerations()
         else:
-            self.bodies[0].step(dt, loads[0])
+            self.bodies[0].step(dt, loads[0], None if rates is None else rates[0])
             accelerations = [self.bodies[0].acceleration]
         v = self.values
         for part, body, acc in zip(self.parts, self.bodies, accelerations):
@@ -367,12 +373,17 @@ class DynamicsSlave(ArraySlave):
             v[part["velocity"]], v[part["acceleration"]] = body.velocity, acc
 
     def physics_state(self):
-        return None if not hasattr(self, "bodies") else [_plain(b.state()) for b in self.bodies]
+        if not hasattr(self, "bodies"):
+            return None
+        last = getattr(self, "last_loads", None)
+        return {"bodies": [_plain(b.state()) for b in self.bodies],
+                "last_loads": None if last is None else (last[0].copy(), last[1])}
 
     def set_physics_state(self, state):
         if state is not None:
-            for body, s in zip(self.bodies, state):
+            for body, s in zip(self.bodies, state["bodies"]):
                 body.set_state(s)
+            self.last_loads = state["last_loads"]
 
 
 class ConnectorSlave(ArraySlave):

@@ -197,9 +197,10 @@ class RigidBody:
             raise GimbalLockError(_gimbal_message(y[3:6]))
         return np.concatenate([y[6:9], _euler_rates(theta, psi, ct, y[9:]), self._accel(y, load)])
 
-    def step(self, dt, external_load):
+    def step(self, dt, external_load, load_rate=None):
         """Advance the state by dt [s] (≥ 0) with the external load [F; M about O] [N, N·m],
-        global axes, held constant.  dt = 0 only replaces the held load."""
+        global axes, held constant, or varying linearly at ``load_rate`` [N/s, N·m/s] from
+        its value at the start of the step.  dt = 0 only replaces the held load."""
         dt = float(dt)
         if not (math.isfinite(dt) and dt >= 0.0):
             raise self._error("dt", f"communication step must be finite and ≥ 0, found {dt}")
@@ -211,12 +212,16 @@ class RigidBody:
             h = dt / n
             sign = 1.0 if math.cos(y[4]) > 0.0 else -1.0
             f = self._deriv
-            for _ in range(n):
-                k1 = f(y, load, sign)
-                k2 = f(y + 0.5 * h * k1, load, sign)
-                k3 = f(y + 0.5 * h * k2, load, sign)
-                k4 = f(y + h * k3, load, sign)
+            rate = np.zeros(6) if load_rate is None else np.asarray(load_rate, dtype=float)
+            for m in range(n):
+                l0 = load + rate * (m * h)
+                lh, l1 = l0 + rate * (0.5 * h), l0 + rate * h
+                k1 = f(y, l0, sign)
+                k2 = f(y + 0.5 * h * k1, lh, sign)
+                k3 = f(y + 0.5 * h * k2, lh, sign)
+                k4 = f(y + h * k3, l1, sign)
                 y = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            load = load + rate * dt
             if abs(math.cos(y[4])) < GIMBAL_TOL:
                 raise GimbalLockError(_gimbal_message(y[3:6]))
         self._y, self._load = y, load
@@ -293,19 +298,24 @@ class CoupledBodies:
             out.append(np.concatenate([y[6:9], _euler_rates(y[4], y[5], ct, y[9:]), a]))
         return np.array(out)
 
-    def step(self, dt, loads):
-        """Advance all bodies by dt [s] with their external loads (list of (6,)) held."""
-        loads = [np.asarray(l, dtype=float) for l in loads]
+    def step(self, dt, loads, rates=None):
+        """Advance all bodies by dt [s] with their external loads (list of (6,)) held, or
+        varying linearly at ``rates`` from their values at the start of the step."""
+        loads = np.array(loads, dtype=float)
+        rates = np.zeros_like(loads) if rates is None else np.array(rates, dtype=float)
         ys = np.array([b._y for b in self.bodies])
         if dt > 0.0:
             n = max(1, math.ceil(dt / self.max_substep * (1.0 - 1e-12)))
             h = dt / n
-            for _ in range(n):
-                k1 = self._deriv(ys, loads)
-                k2 = self._deriv(ys + 0.5 * h * k1, loads)
-                k3 = self._deriv(ys + 0.5 * h * k2, loads)
-                k4 = self._deriv(ys + h * k3, loads)
+            for m in range(n):
+                l0 = loads + rates * (m * h)
+                lh, l1 = l0 + rates * (0.5 * h), l0 + rates * h
+                k1 = self._deriv(ys, l0)
+                k2 = self._deriv(ys + 0.5 * h * k1, lh)
+                k3 = self._deriv(ys + 0.5 * h * k2, lh)
+                k4 = self._deriv(ys + h * k3, l1)
                 ys = ys + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            loads = loads + rates * dt
         for b, y, load in zip(self.bodies, ys, loads):
             b._y, b._load = y, load
 
