@@ -149,3 +149,40 @@ def test_save_restore_with_memory(tmp_path):
         fmu.close()
     np.testing.assert_array_equal(runs[0], runs[1])
     assert np.abs(runs[0][:, :6]).max() > 1.0  # the memory is really there
+
+
+@pytest.mark.parametrize("mode", ["export", "explicit"])
+def test_build_reports_stability_indicator(tmp_path, mode):
+    """ρ[(M_A+A_AA)⁻¹·A_AB·(M_B+A_BB)⁻¹·A_BA] by hand for diagonal blocks: the largest
+    A_AB,ii² / ((M+A_AA,ii)(M+A_BB,ii)); a warning only when explicit coupling diverges."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    big = np.diag([0, 3.0e6, 0, 0, 0, 0])          # cross sway added mass larger than M + A_self
+    deck = write_deck(tmp_path / "big.sim", [
+        coupling_group("SELFA", "A", "A", SELF_AM, {}, TIMDEL, LENGTH),
+        coupling_group("SELFB", "B", "B", SELF_AM, {}, TIMDEL, LENGTH),
+        coupling_group("AB", "A", "B", big, {}, TIMDEL, LENGTH)])
+    body = lambda n, y: f"""
+        [bodies.{n}]
+        position = [0.0, {y}, 0.0]
+        mass = {M}
+        inertia = {I}
+        stiffness = {K.tolist()}
+        acceleration_loads = "{mode}"
+        """
+    couplings = "".join(f"""
+        [[couplings]]
+        deck = "{deck}"
+        coupling = "{c}"
+        bodies = {{ A = "a", B = "b" }}
+        """ for c in ("SELFA", "SELFB", "AB"))
+    from conftest import write_scene
+    path = write_scene(tmp_path, "[scene]\nname = 'unstable'\n" + body("a", 0) + body("b", 40) + couplings)
+    messages = []
+    folder = build_scene(load_scene(path), tmp_path / "out", log=messages.append)
+    import json
+    rho = json.loads((folder / "manifest.json").read_text())["stability_indicators"]["AB"]
+    expected = 3.0e6 ** 2 / ((M + 5.0e5) * (M + 5.0e5))     # sway: M + A_self = 1.5e6
+    assert rho == pytest.approx(expected, rel=1e-12)
+    warned = any("WARNING" in m and "AB" in m for m in messages)
+    assert warned == (mode == "explicit")

@@ -66,20 +66,22 @@ def initial_motion(body):
     return Motion(np.array(body.position, float), np.array(body.attitude, float))
 
 
-def exported_mass(scene):
-    """Per body: the 6×6 mass its load FMU and the joints' nodes on it export (export mode)."""
+def exported_mass(scene, every_mode=False):
+    """Per body: the 6×6 mass its load FMU, its self-couplings and the joints' nodes on it
+    export (export mode); ``every_mode``: the body's own added mass whatever the mode."""
+    export = lambda mode: every_mode or mode == "export"
     out = {}
     for body in scene.bodies.values():
         m = np.zeros((6, 6))
-        if body.accel_mode == "export":
+        if export(body.accel_mode):
             m += body_loads(scene, body).mass_matrix(initial_motion(body))
         out[body.name] = m
     for joint in scene.joints.values():
         node = joint_node(joint)
-        if joint.accel_mode == "export" and node.uses_acceleration:
+        if export(joint.accel_mode) and node.uses_acceleration:
             out[joint.a] = out[joint.a] + node.mass_matrix(initial_motion(scene.bodies[joint.a]))
     for target, source, mass, _ in coupling_sides(scene.couplings):
-        if target == source and scene.bodies[target].accel_mode == "export":
+        if target == source and export(scene.bodies[target].accel_mode):
             out[target] = out[target] + mass
     return out
 
@@ -356,7 +358,7 @@ def build_scene(scene, outdir, shim=True, log=print):
     target = outdir / scene.name
     specs, dyn_of = fmu_specs(scene)
     runtime = runtime_name()
-    indicators = stability_indicators(scene, exported_mass(scene))
+    indicators = stability_indicators(scene, exported_mass(scene, every_mode=True))
     for name, rho in indicators.items():
         c = next(c for c in scene.couplings if c.name == name)
         explicit = "explicit" in (scene.bodies[c.a].accel_mode, scene.bodies[c.b].accel_mode)

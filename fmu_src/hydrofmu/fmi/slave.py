@@ -223,7 +223,8 @@ class LoadSlave(ArraySlave):
                     f"acceleration of coupled body {src}, global")
             out = self.add_vector(f"{c['name']}.force", 6, Out, LIN_ROT["force"], None,
                                   f"hydrodynamic coupling {c['name']} (from {src}'s motion)")
-            self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out})
+            self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
+                                   "mass": np.asarray(c["mass"], dtype=float), "memory": None})
             inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
         self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
                                      "total load on the body, global axes, moments about the reference point")
@@ -254,8 +255,6 @@ class LoadSlave(ArraySlave):
             data = SimpleNamespace(name=cfg["name"], body_a="A", body_b="A" if cfg["self"] else "B",
                                    added_mass=d["added_mass"], timdel=d["timdel"],
                                    kernels={(i, j): np.asarray(h) for i, j, h in d["kernels"]})
-            c["mass"] = np.asarray(cfg["mass"])
-            c["memory"] = None
             if d["kernels"]:
                 model = Coupling(data, cfg["method"], cfg["tolerance"], cfg["order"], cfg["memory_length"],
                                  v0_a=v0, v0_b=v0)
@@ -273,7 +272,7 @@ class LoadSlave(ArraySlave):
             self.values[s] = load
         for c in self.couplings:
             load = np.zeros(6)
-            if c.get("memory") is not None:
+            if c["memory"] is not None:
                 load = c["memory"].force(self.time, self.values[c["velocity"]])
             if c["acceleration"] is not None:
                 load = load - c["mass"] @ self.values[c["acceleration"]]
@@ -283,14 +282,14 @@ class LoadSlave(ArraySlave):
 
     def advance(self, t, dt):
         for c in self.couplings:
-            if c.get("memory") is not None:
+            if c["memory"] is not None:
                 c["memory"].commit(t, self.values[c["velocity"]])
         self.time = t + dt
         self.stale = bool(self.couplings)  # memory outputs move with time
 
     def physics_state(self):
         return {"time": self.time,
-                "memory": [None if c.get("memory") is None else c["memory"].state() for c in self.couplings]}
+                "memory": [None if c["memory"] is None else c["memory"].state() for c in self.couplings]}
 
     def set_physics_state(self, state):
         self.time = state["time"]
