@@ -29,10 +29,25 @@ def scene(tmp_path, method="convolution", mode="export", algorithm="gauss-seidel
         coupling_group("SELFA", "A", "A", SELF_AM, SELF_K, TIMDEL, LENGTH),
         coupling_group("SELFB", "B", "B", SELF_AM, SELF_K, TIMDEL, LENGTH),
         coupling_group("AB", "A", "B", CROSS_AM, CROSS_K, TIMDEL, LENGTH)])
+    text = pair_text(deck, mode, f'method = "{method}"\n        {extra}', velocities=True)
+    return build(tmp_path, f"""
+        [scene]
+        name = "pair"
+        [run]
+        step = {step}
+        stop = 60.0
+        algorithm = "{algorithm}"
+        load_hold = "{hold}"
+        substep = 0.01
+        """ + text)
+
+
+def pair_text(deck, mode, coupling_extra="", velocities=False):
+    """Scene text of bodies a (y = 0) and b (y = 40 m) and the couplings SELFA, SELFB, AB."""
     body = lambda n, y: f"""
         [bodies.{n}]
         position = [0.0, {y}, 0.0]
-        velocity = {V0[n]}
+        {f"velocity = {V0[n]}" if velocities else ""}
         mass = {M}
         inertia = {I}
         stiffness = {K.tolist()}
@@ -43,19 +58,9 @@ def scene(tmp_path, method="convolution", mode="export", algorithm="gauss-seidel
         deck = "{deck}"
         coupling = "{c}"
         bodies = {{ A = "a", B = "b" }}
-        method = "{method}"
-        {extra}
+        {coupling_extra}
         """ for c in ("SELFA", "SELFB", "AB"))
-    return build(tmp_path, f"""
-        [scene]
-        name = "pair"
-        [run]
-        step = {step}
-        stop = 60.0
-        algorithm = "{algorithm}"
-        load_hold = "{hold}"
-        substep = 0.01
-        """ + body("a", 0.0) + body("b", 40.0) + couplings)
+    return body("a", 0.0) + body("b", 40.0) + couplings
 
 
 def monolithic(t_eval):
@@ -162,22 +167,8 @@ def test_build_reports_stability_indicator(tmp_path, mode):
         coupling_group("SELFA", "A", "A", SELF_AM, {}, TIMDEL, LENGTH),
         coupling_group("SELFB", "B", "B", SELF_AM, {}, TIMDEL, LENGTH),
         coupling_group("AB", "A", "B", big, {}, TIMDEL, LENGTH)])
-    body = lambda n, y: f"""
-        [bodies.{n}]
-        position = [0.0, {y}, 0.0]
-        mass = {M}
-        inertia = {I}
-        stiffness = {K.tolist()}
-        acceleration_loads = "{mode}"
-        """
-    couplings = "".join(f"""
-        [[couplings]]
-        deck = "{deck}"
-        coupling = "{c}"
-        bodies = {{ A = "a", B = "b" }}
-        """ for c in ("SELFA", "SELFB", "AB"))
     from conftest import write_scene
-    path = write_scene(tmp_path, "[scene]\nname = 'unstable'\n" + body("a", 0) + body("b", 40) + couplings)
+    path = write_scene(tmp_path, "[scene]\nname = 'unstable'\n" + pair_text(deck, mode))
     messages = []
     folder = build_scene(load_scene(path), tmp_path / "out", log=messages.append)
     import json
