@@ -149,7 +149,7 @@ def test_joined_barges_energy_does_not_grow(tmp_path):
         inertia = {inertia.tolist()}
         stiffness = {k.tolist()}
         """
-    folder = build(tmp_path, f"""
+    folder = build(tmp_path, """
         [scene]
         name = "energy"
         [run]

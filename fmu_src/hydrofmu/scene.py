@@ -108,7 +108,7 @@ class Problems:
         if value is None:
             self.add(where, f"missing {n}-vector")
             return None
-        arr = self._array(value, where)
+        arr = self.array(value, where)
         if arr is None:
             return None
         if arr.shape != (n,):
@@ -122,7 +122,7 @@ class Problems:
         if value is None:
             self.add(where, f"missing {n}x{n} matrix")
             return None
-        arr = self._array(value, where)
+        arr = self.array(value, where)
         if arr is None:
             return None
         if diagonal_ok and arr.shape == (n,):
@@ -153,7 +153,7 @@ class Problems:
                 self.add(f"{where}.{key}" if where else key,
                          f"unknown key (allowed: {', '.join(sorted(allowed))})")
 
-    def _array(self, value, where):
+    def array(self, value, where):
         try:
             arr = np.array(value, dtype=float)
         except (TypeError, ValueError):
@@ -228,7 +228,7 @@ def _deeplines_current_polar(problems, table, where):
         point = problems.vector(table, "point", f"{where}.point", 3)
         surface = problems.number(table, "surface", f"{where}.surface", positive=True)
         raw = table.get("table")
-        arr = problems._array(raw, f"{where}.table") if raw is not None else None
+        arr = problems.array(raw, f"{where}.table") if raw is not None else None
         if raw is None:
             problems.add(f"{where}.table", "missing table of [angle, CX, CY, CMZ] rows")
         elif arr is not None and (arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 2):

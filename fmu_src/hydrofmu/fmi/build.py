@@ -57,7 +57,7 @@ class {model_id}({slave}):
 '''
 
 
-def body_loads(scene, body):
+def body_loads(body):
     explicit = body.accel_mode == "explicit"
     return BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects], explicit)
 
@@ -74,7 +74,7 @@ def exported_mass(scene, every_mode=False):
     for body in scene.bodies.values():
         m = np.zeros((6, 6))
         if export(body.accel_mode):
-            m += body_loads(scene, body).mass_matrix(initial_motion(body))
+            m += body_loads(body).mass_matrix(initial_motion(body))
         out[body.name] = m
     for joint in scene.joints.values():
         node = joint_node(joint)

@@ -424,14 +424,14 @@ class ConnectorSlave(ArraySlave):
             return
         a = self.motion(self.side_a)
         b = self.motion(self.side_b) if self.side_b else None
-        load_a, load_b = self.joint.loads(a, b, self.env())
+        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, self.env())
         if self.joint.uses_acceleration:
             if self.explicit:
                 load_a = load_a - self.joint.mass_matrix(a) @ a.acceleration
             load_a = load_a + self.joint.velocity_load(a)
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
-        v[self.gap], v[self.rotation] = self.joint.deformation(a, b)
+        v[self.gap], v[self.rotation] = gap, rotation
 
 
 class FeedthroughMemory:

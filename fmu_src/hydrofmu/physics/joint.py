@@ -112,26 +112,28 @@ class BallJoint:
 
     def deformation(self, motion_a, motion_b):
         """Gap d = p_B − p_A [m] (global) and rotation vector θ [rad] (A's axes)."""
-        rot_a = motion_a.rot
-        rot_b, _, p_b, _, _ = self._side_b(motion_b)
-        d = p_b - (motion_a.position + rot_a @ self.point_a)
-        return d, log_rotation(rot_a.T @ rot_b @ self.r_rel0.T)
+        return self.loads_and_deformation(motion_a, motion_b, None)[2:]
 
     def loads(self, motion_a, motion_b, env):
         """(load on A, load on B), each (6,) global about that side's reference point
         (the earth's about the joint point).  The node's static and drag loads are in A's;
         its acceleration loads are in ``mass_matrix``/``velocity_load`` (side A)."""
+        return self.loads_and_deformation(motion_a, motion_b, env)[:2]
+
+    def loads_and_deformation(self, motion_a, motion_b, env):
+        """(load on A, load on B, gap d, rotation vector θ) in one pass; env None: no node loads."""
         rot_a = motion_a.rot
         r_a = rot_a @ self.point_a
         rot_b, r_b, p_b, v_b, w_b = self._side_b(motion_b)
-        f = self.k_lin * (p_b - motion_a.position - r_a) + self.c_lin * (v_b - point_velocity(motion_a.velocity, r_a))
+        d = p_b - motion_a.position - r_a
+        f = self.k_lin * d + self.c_lin * (v_b - point_velocity(motion_a.velocity, r_a))
         theta = log_rotation(rot_a.T @ rot_b @ self.r_rel0.T)
         w_rel = rot_a.T @ (w_b - motion_a.velocity[3:])
         m = rot_a @ np.where(self.free, 0.0, self.k_rot * theta + self.c_rot * w_rel)
         load_a = transfer(f, r_a, m)
-        if self.node is not None:
+        if self.node is not None and env is not None:
             load_a = load_a + self.node.load(motion_a, env)
-        return load_a, transfer(-f, r_b, -m)
+        return load_a, transfer(-f, r_b, -m), d, theta
 
     def mass_matrix(self, motion_a):
         """6×6 mass of the node about A's reference point (zeros without a node)."""

@@ -151,7 +151,7 @@ class Convolution:
 
     def _weights(self, s):
         """W[k, e] = ∫ h_e(σ)·φ_k(σ) dσ with φ_k the hat function of node k (offset s_k)."""
-        g, hl, hr = self._g, self._hl, self._hr
+        g, hl = self._g, self._hl
         top = min(s[-1], g[-1])
         p = np.union1d(s, g)
         p = p[p <= top]

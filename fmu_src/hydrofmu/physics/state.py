@@ -13,6 +13,7 @@ Load kernels ("effects") follow one protocol so the FMU wrapper can hold any mix
                               # (applied only in `explicit` mode, else exported)
 """
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -31,9 +32,10 @@ class Motion:
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
     acceleration: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
-    @property
+    @cached_property
     def rot(self):
-        """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ)."""
+        """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) (computed once: a Motion
+        is a snapshot, every effect of an evaluation reads it)."""
         return rotation(self.attitude)
 
 
