@@ -437,38 +437,30 @@ class ConnectorSlave(ArraySlave):
 class FeedthroughMemory:
     """A retardation-memory evaluator seen through FMI: its output follows the current
     input before the step commits it.  The pending interval [t_commit, t] (velocity
-    linear, ending at the current input) is evaluated on a copy of the state; ``commit``
-    keeps that result when the step confirms the same interval."""
+    linear, ending at the current input) is evaluated by the evaluator's ``peek``, which
+    leaves its history alone; ``commit`` moves it, reusing the peek when the step
+    confirms the same interval."""
 
     def __init__(self, evaluator, t0):
-        self.ev, self.t, self._peek = evaluator, t0, None
+        self.ev, self.t = evaluator, t0
 
     def force(self, t, v):
         dt = t - self.t
         if dt <= 0.0:
             return np.asarray(self.ev.force, dtype=float).copy()
-        saved = self.ev.state()
-        f = np.asarray(self.ev.advance(dt, v), dtype=float).copy()
-        self._peek = (dt, np.array(v, dtype=float), self.ev.state())
-        self.ev.set_state(saved)
-        return f
+        return self.ev.peek(dt, v)
 
     def commit(self, t, v):
         dt = t - self.t
-        if dt <= 0.0:
-            return
-        peek = self._peek
-        if peek is not None and peek[0] == dt and np.array_equal(peek[1], v):
-            self.ev.set_state(peek[2])
-        else:
+        if dt > 0.0:
             self.ev.advance(dt, v)
-        self.t, self._peek = t, None
+            self.t = t
 
     def state(self):
         return {"t": self.t, "ev": self.ev.state()}
 
     def set_state(self, state):
-        self.t, self._peek = state["t"], None
+        self.t = state["t"]
         self.ev.set_state(state["ev"])
 
 

@@ -102,6 +102,7 @@ class Convolution:
         self._dt = np.zeros(64)           # _dt[k]: time from node k − 1 to node k
         self._v[0], self._lo, self._hi = v, 0, 1
         self._key = self._w = None        # cached node offsets and their weights
+        self._peeked = None               # (dt, v, force, lo) of the last peek
         self.force = np.zeros(self.shape[0])
 
     @property
@@ -114,40 +115,57 @@ class Convolution:
         """Number of velocity breakpoints held (bounded by span / smallest dt + 2)."""
         return self._hi - self._lo
 
-    def advance(self, dt, v_new):
-        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+    def peek(self, dt, v_new):
+        """The memory load F(t + dt) if the velocity reached v_new at t + dt, without
+        moving: the history is unchanged, and a following ``advance`` with the same
+        arguments reuses the result (an FMU's feedthrough output before its step)."""
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
-        if self._hi == self._v.shape[0]:          # make room: grow when over half full,
-            n = self._hi - self._lo               # else compact (amortised O(1) per step)
-            if 2 * n > self._v.shape[0]:
-                self._v = np.concatenate([self._v, np.zeros_like(self._v)])
-                self._dt = np.concatenate([self._dt, np.zeros_like(self._dt)])
-            else:
-                self._v[:n] = self._v[self._lo:self._hi]
-                self._dt[:n] = self._dt[self._lo:self._hi]
-                self._lo, self._hi = 0, n
+        if self._hi == self._v.shape[0]:
+            self._make_room()
         self._v[self._hi] = v_new
         self._dt[self._hi] = dt
+        force, lo = self._evaluate(self._hi + 1)
+        self._peeked = (float(dt), self._v[self._hi].copy(), force, lo)
+        return force.copy()
+
+    def advance(self, dt, v_new):
+        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+        p = self._peeked
+        if p is None or p[0] != dt or not np.array_equal(p[1], v_new):
+            self.peek(dt, v_new)
+        _, _, self.force, self._lo = self._peeked
         self._hi += 1
-        self.force = self._evaluate()
+        self._peeked = None
         return self.force.copy()
 
-    def _evaluate(self):
-        lo, hi = self._lo, self._hi
+    def _make_room(self):
+        """Grow the buffer when over half full, else compact it (amortised O(1) per step)."""
+        n = self._hi - self._lo
+        if 2 * n > self._v.shape[0]:
+            self._v = np.concatenate([self._v, np.zeros_like(self._v)])
+            self._dt = np.concatenate([self._dt, np.zeros_like(self._dt)])
+        else:
+            self._v[:n] = self._v[self._lo:self._hi]
+            self._dt[:n] = self._dt[self._lo:self._hi]
+            self._lo, self._hi = 0, n
+
+    def _evaluate(self, hi):
+        """(F at the node hi − 1, first node still needed) from the nodes lo … hi − 1."""
+        lo = self._lo
         s = np.zeros(hi - lo)                     # node offsets back in time, newest first
         np.cumsum(self._dt[hi - 1:lo:-1], out=s[1:])
         k = int(np.searchsorted(s, self.span, "left"))
         if k < s.size - 1:                        # nodes beyond the first past the span
-            self._lo = lo = hi - (k + 1)          # never matter again: drop them
+            lo = hi - (k + 1)                     # never matter again
             s = s[: k + 1]
         if not self._out.size or s.size < 2 or self.span == 0.0:
-            return np.zeros(self.shape[0])
+            return np.zeros(self.shape[0]), lo
         if self._key is None or self._key.shape != s.shape or not np.array_equal(self._key, s):
             self._key, self._w = s, self._weights(s)
         v = self._v[hi - 1:lo - 1 if lo else None:-1]   # newest first, like s
         f = np.einsum("ke,ke->e", self._w, v[:, self._in])
-        return -np.bincount(self._out, weights=f, minlength=self.shape[0])
+        return -np.bincount(self._out, weights=f, minlength=self.shape[0]), lo
 
     def _weights(self, s):
         """W[k, e] = ∫ h_e(σ)·φ_k(σ) dσ with φ_k the hat function of node k (offset s_k)."""
@@ -194,6 +212,7 @@ class Convolution:
         self._dt[1: v.shape[0]] = state["dt"]
         self._lo, self._hi = 0, v.shape[0]
         self.force = np.array(state["force"], float)
+        self._peeked = None
 
 
 @dataclass
@@ -374,8 +393,12 @@ class StateSpace:
         self._inp, self._out = np.array(inp, int), np.array(out, int)
         self.order = sum(f.order for f in self.fits.values())   # real states
         self._z = np.zeros(len(mu), complex)
+        # F = −Re(Γ·z) as one product: Γ[i, mode] = γ of the modes that load component i
+        self._gain = np.zeros((self.shape[0], len(mu)), complex)
+        self._gain[self._out, np.arange(len(mu))] = -self._gam
         self._v = _start(self.shape, v0)
         self._cache = OrderedDict()
+        self._peeked = None
         self.force = np.zeros(self.shape[0])
 
     @property
@@ -383,28 +406,38 @@ class StateSpace:
         return self._v.copy()
 
     def _discrete(self, dt):
+        """(e^{μdt}, dt·(φ₁ − φ₂), dt·φ₂): z_new = e·z + p·v_old + q·v_new per mode."""
         key = float(dt)
         if key not in self._cache:
             x = self._mu * dt
             p1, p2 = _phi(x)
-            self._cache[key] = (np.exp(x), dt * p1, dt * p2)
+            self._cache[key] = (np.exp(x), dt * (p1 - p2), dt * p2)
             if len(self._cache) > 16:
                 self._cache.popitem(last=False)
         self._cache.move_to_end(key)
         return self._cache[key]
 
-    def advance(self, dt, v_new):
-        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+    def peek(self, dt, v_new):
+        """The memory load F(t + dt) if the velocity reached v_new at t + dt, without
+        moving (a following ``advance`` with the same arguments reuses the result)."""
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
         v_new = np.array(v_new, float).reshape(self.shape[1])
+        z, force = self._z, self.force
         if self._mu.size:
-            e, q1, q2 = self._discrete(dt)
-            v0, dv = self._v[self._inp], (v_new - self._v)[self._inp]
-            self._z = e * self._z + q1 * v0 + q2 * dv
-            f = (self._gam * self._z).real
-            self.force = -np.bincount(self._out, weights=f, minlength=self.shape[0])
-        self._v = v_new
+            e, p, q = self._discrete(dt)
+            z = e * self._z + p * self._v[self._inp] + q * v_new[self._inp]
+            force = (self._gain @ z).real
+        self._peeked = (float(dt), v_new, z, force)
+        return force.copy()
+
+    def advance(self, dt, v_new):
+        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+        p = self._peeked
+        if p is None or p[0] != dt or not np.array_equal(p[1], v_new):
+            self.peek(dt, v_new)
+        _, self._v, self._z, self.force = self._peeked
+        self._peeked = None
         return self.force.copy()
 
     def state(self):
@@ -417,3 +450,4 @@ class StateSpace:
         self._z = np.array(state["z_re"], float) + 1j * np.array(state["z_im"], float)
         self._v = np.array(state["v"], float).reshape(self.shape[1])
         self.force = np.array(state["force"], float)
+        self._peeked = None
