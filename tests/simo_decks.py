@@ -2,6 +2,8 @@
 TIMDEL: one analytic family that a monolithic reference can integrate exactly."""
 import numpy as np
 
+from hydrofmu.decks.simo import format_coupling, write_couplings
+
 
 def kernel(c, a, w, timdel, length):
     t = np.arange(int(round(length / timdel)) + 1) * timdel
@@ -10,22 +12,10 @@ def kernel(c, a, w, timdel, length):
 
 def coupling_group(name, body_a, body_b, added_mass, kernels, timdel, length, text="analytic kernels"):
     """``added_mass``: 6×6; ``kernels``: {(IDOF_A, IDOF_B): (c, a, ω)}."""
-    lines = ["HYDRodynamic COUPling DATA", name, text, "h(t) = c exp(-a t) cos(w t)", body_a, body_b,
-             "COUPled ADDEd MASS"]
-    lines += ["  " + "  ".join(f"{x:.6e}" for x in row) for row in np.asarray(added_mass, float)]
-    if kernels:
-        lines += ["COUPled RETArdation FUNCtion", f"{timdel}", "RETArdation ELEment DATA"]
-        for (i, j), (c, a, w) in kernels.items():
-            h = kernel(c, a, w, timdel, length)
-            lines.append(f"{len(h)} {i} {j}")
-            rows = [" ".join(f"{x:.9e}" for x in h[k:k + 6]) for k in range(0, len(h), 6)]
-            lines += [r + " &" for r in rows[:-1]] + [rows[-1]]
-    return lines
+    sampled = {ij: kernel(*cawv, timdel, length) for ij, cawv in kernels.items()}
+    return format_coupling(name, body_a, body_b, added_mass, sampled, timdel,
+                           (text, "h(t) = c exp(-a t) cos(w t)"))
 
 
 def write_deck(path, groups, header="SIMO hydrodynamic coupling data (SI units)"):
-    text = [f"' {header}"]
-    for g in groups:
-        text += ["'"] + g
-    path.write_text("\n".join(text) + "\n")
-    return path
+    return write_couplings(path, groups, header)

@@ -3,23 +3,16 @@ coupled added mass and retardation memory + the coupled dynamics partner) agains
 monolithic scipy solution of the same Cummins equations."""
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
+from hydrofmu.bench import fleet
+from hydrofmu.bench.fleet import (CROSS_AM, CROSS_K, INERTIA as I, K, LENGTH, M, SELF_AM, SELF_K,  # noqa: F401
+                                  TIMDEL, Fleet, nrms)
 from hydrofmu.cosim.master import run
 
 from conftest import build
 from simo_decks import coupling_group, write_deck
 
-M, I = 1.0e6, [1.0e8, 2.0e8, 2.0e8]
-# 1000 t body, 20 m x 20 m waterplane: heave K = ρ·g·A_wp ≈ 4e6 N/m (heave period ≈ 4 s)
-K = np.array([1.0e5, 1.2e5, 4.0e6, 1.0e9, 1.0e9, 1.0e9])
-SELF_AM = np.diag([1.0e5, 5.0e5, 8.0e5, 0, 0, 0])
-CROSS_AM = np.zeros((6, 6))
-CROSS_AM[1, 1], CROSS_AM[2, 2], CROSS_AM[1, 2] = 2.0e5, 1.0e5, 5.0e4
-SELF_K = {(1, 1): (1.0e5, 0.6, 1.0), (2, 2): (3.0e5, 0.5, 1.2), (3, 3): (6.0e5, 0.8, 1.5)}
-CROSS_K = {(2, 2): (1.0e5, 0.5, 0.8), (3, 3): (1.5e5, 0.7, 1.1), (2, 3): (4.0e4, 0.6, 0.9)}
-V0 = {"a": [0.1, 0.5, 0.2, 0, 0, 0], "b": [0.0] * 6}
-TIMDEL, LENGTH = 0.1, 40.0
+V0 = {"a": list(fleet.V0), "b": [0.0] * 6}
 
 
 def scene(tmp_path, method="convolution", mode="export", algorithm="gauss-seidel", step=0.05, extra="",
@@ -64,48 +57,15 @@ def pair_text(deck, mode, coupling_extra="", velocities=False):
 
 
 def monolithic(t_eval):
-    """Cummins equations of both bodies (12 dofs), translations only (rotations stay at
-    rest), kernels c·e^(−at)·cos(ωt) as exact complex first-order states:
-    (M + A∞)·ẍ + Σ ∫ h(t−τ)·ẋ(τ)dτ + K·x = 0."""
-    n = 12
-    mass = np.diag(np.tile([M, M, M] + I, 2))
-    mass[:6, :6] += SELF_AM
-    mass[6:, 6:] += SELF_AM
-    mass[:6, 6:] += CROSS_AM          # load on A from B's acceleration: A∞
-    mass[6:, :6] += CROSS_AM.T        # load on B from A's acceleration: A∞ᵀ
-    stiff = np.diag(np.tile(K, 2))
-    # memory terms: (row dof, column dof, c, a, ω): load on row from velocity of column
-    terms = []
-    for (i, j), (c, a, w) in SELF_K.items():
-        terms += [(i - 1, j - 1, c, a, w), (6 + i - 1, 6 + j - 1, c, a, w)]
-    for (i, j), (c, a, w) in CROSS_K.items():
-        terms += [(i - 1, 6 + j - 1, c, a, w), (6 + j - 1, i - 1, c, a, w)]
-    inv = np.linalg.inv(mass)
-
-    def rhs(_, y):
-        x, v, z = y[:n], y[n:2 * n], y[2 * n:].view(complex) if False else y[2 * n:]
-        force = -stiff @ x
-        dz = np.empty_like(z)
-        for k, (r, col, c, a, w) in enumerate(terms):
-            zr, zi = z[2 * k], z[2 * k + 1]
-            force[r] -= c * zr                     # Re(c·z), z' = (−a + iω)·z + v
-            dz[2 * k] = -a * zr - w * zi + v[col]
-            dz[2 * k + 1] = w * zr - a * zi
-        return np.concatenate([v, inv @ force, dz])
-
-    y0 = np.concatenate([np.zeros(n), V0["a"], V0["b"], np.zeros(2 * len(terms))])
-    sol = solve_ivp(rhs, (0, t_eval[-1]), y0, t_eval=t_eval, rtol=1e-10, atol=1e-12, method="DOP853")
-    return sol.y[:n].T
+    """Translations and rotations of both bodies from the monolithic scipy solution of the
+    Cummins equations (bench.fleet: assembled by hand, kernels as exact complex states)."""
+    return Fleet(2).monolithic(t_eval)
 
 
 def positions(result):
     """Displacements from the initial positions: surge, sway, heave of a, then of b."""
     pos = np.hstack([result.motion(b, "position", 3) for b in ("a", "b")])
     return pos - pos[0]
-
-
-def nrms(got, ref):
-    return np.sqrt(np.mean((got - ref) ** 2, axis=0)) / np.ptp(ref, axis=0)
 
 
 def test_two_bodies_match_monolithic_cummins(tmp_path):

@@ -4,6 +4,7 @@ import json
 import sys
 from pathlib import Path
 
+from .cosim.master import describe
 from .errors import InputError
 
 DEFAULT_OUT = Path("build") / "fmus"
@@ -91,13 +92,13 @@ def main(argv=None):
                 folder = next(iter(build([folder], args.out).values()))
             result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
                                 algorithm=args.algorithm)
-            print(f"ran {folder.name}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm})")
+            print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)})")
         elif args.command == "demo":
             folders = build(scenes_in([]), args.out)
             for name in args.scene or folders:
                 csv, png = args.out / f"{name}.csv", args.out / f"{name}.png"
                 result = run_folder(folders[name], "fmpy", csv, png)
-                print(f"ran {name}: {len(result.time) - 1} steps of {result.step:g} s ({result.algorithm}); "
+                print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
                       f"wrote {csv} and {png}")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)

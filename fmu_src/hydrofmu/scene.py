@@ -304,6 +304,22 @@ EFFECT_TYPES = {
     "riflex_body": (_riflex_body, "riflex_body"),
 }
 
+RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "constant"}
+MEMORY_DEFAULTS = {"method": "convolution", "tolerance": 0.01, "memory_length": None}
+
+# Speed/accuracy presets a scene names with [run] preset = "…": each sets the run knobs
+# and the default memory evaluator of every coupling; knobs the scene sets still win.
+# The figures behind each choice are in the README (measured by `hydrofmu bench`).
+PRESETS = {
+    "screening": {"step": 0.2, "algorithm": "gauss-seidel", "substep": 0.05, "load_hold": "linear",
+                  "memory": {"method": "state_space", "tolerance": 0.05, "memory_length": None}},
+    "design": {"step": 0.05, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "linear",
+               "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None}},
+    "reference": {"step": 0.01, "algorithm": "gauss-seidel", "substep": 0.005, "load_hold": "linear",
+                  "memory": {"method": "convolution", "tolerance": 0.01, "memory_length": None}},
+}
+
+
 COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length"}
 
 
@@ -321,9 +337,10 @@ class Coupling:
     tolerance: float = 0.01
     order: object = None
     memory_length: object = None
+    set: list = field(default_factory=list)   # memory knobs the scene sets itself
 
 
-def _couplings(problems, items, bodies):
+def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
     from .decks.simo import read_couplings
     if not isinstance(items, list):
         problems.add("couplings", "expected an array of tables ([[couplings]])")
@@ -343,13 +360,14 @@ def _couplings(problems, items, bodies):
         known = set(mapping) | set(bodies)
         path = _deck_path(problems, table, where)
         name = problems.string(table, "coupling", f"{where}.coupling")
-        method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"), "convolution")
-        tol = problems.number(table, "tolerance", f"{where}.tolerance", 0.01, positive=True)
+        method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"),
+                                 memory["method"])
+        tol = problems.number(table, "tolerance", f"{where}.tolerance", memory["tolerance"], positive=True)
         order = table.get("order")
         if order is not None and (not isinstance(order, int) or isinstance(order, bool) or order < 1):
             problems.add(f"{where}.order", f"expected a positive integer, found {order!r}")
-        memory = (problems.number(table, "memory_length", f"{where}.memory_length", positive=True)
-                  if "memory_length" in table else None)
+        length = (problems.number(table, "memory_length", f"{where}.memory_length", positive=True)
+                  if "memory_length" in table else memory["memory_length"])
         if path is None or name is None or method is None:
             continue
         try:
@@ -373,7 +391,8 @@ def _couplings(problems, items, bodies):
             "added_mass": np.asarray(d.added_mass, float).tolist(),
             "timdel": d.timdel,
             "kernels": [[i_, j_, np.asarray(h, float).tolist()] for (i_, j_), h in d.kernels.items()],
-        }, method, tol, order, memory))
+        }, method, tol, order, length, sorted(k for k in ("method", "tolerance", "order", "memory_length")
+                                               if k in table)))
     return out
 
 
@@ -429,9 +448,6 @@ def _joint(problems, name, table, where, bodies):
 
 BODY_KEYS = {"position", "attitude", "velocity", "mass", "inertia", "cog", "stiffness", "damping",
              "acceleration_loads", "effects"}
-RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "constant"}
-
-
 def _body(problems, name, table, where):
     problems.known_keys(table, where, BODY_KEYS)
     if not identifier(name):
@@ -501,14 +517,21 @@ def load_scene(path):
     env = p.table(doc, "environment", "environment", required=False) or {}
     p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction"})
     run = p.table(doc, "run", "run", required=False) or {}
-    p.known_keys(run, "run", set(RUN_DEFAULTS))
+    p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset"})
+    preset = run.get("preset")
+    if preset is not None and preset not in PRESETS:
+        p.add("run.preset", f"expected one of {', '.join(map(repr, PRESETS))}, found {preset!r}")
+        preset = None
+    base = {**RUN_DEFAULTS, **PRESETS.get(preset, {})}
     run_cfg = {
-        "step": p.number(run, "step", "run.step", RUN_DEFAULTS["step"], positive=True),
-        "stop": p.number(run, "stop", "run.stop", RUN_DEFAULTS["stop"], positive=True),
-        "algorithm": p.choice(run, "algorithm", "run.algorithm", ("jacobi", "gauss-seidel"),
-                              RUN_DEFAULTS["algorithm"]),
-        "substep": p.number(run, "substep", "run.substep", RUN_DEFAULTS["substep"], positive=True),
-        "load_hold": p.choice(run, "load_hold", "run.load_hold", ("constant", "linear"), "constant"),
+        "preset": preset,
+        "step": p.number(run, "step", "run.step", base["step"], positive=True),
+        "stop": p.number(run, "stop", "run.stop", base["stop"], positive=True),
+        "algorithm": p.choice(run, "algorithm", "run.algorithm", ("jacobi", "gauss-seidel"), base["algorithm"]),
+        "substep": p.number(run, "substep", "run.substep", base["substep"], positive=True),
+        "load_hold": p.choice(run, "load_hold", "run.load_hold", ("constant", "linear"), base["load_hold"]),
+        "memory": dict(base.get("memory", MEMORY_DEFAULTS)),
+        "set": sorted(k for k in run if k != "preset"),   # knobs the scene sets itself
     }
     bodies_t = p.table(doc, "bodies", "bodies") or {}
     bodies = {}
@@ -528,7 +551,7 @@ def load_scene(path):
         joint = _joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
-    couplings = _couplings(p, doc["couplings"], bodies) if "couplings" in doc else []
+    couplings = _couplings(p, doc["couplings"], bodies, run_cfg["memory"]) if "couplings" in doc else []
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings,
         rho=p.number(env, "rho", "environment.rho", 1025.0, positive=True),

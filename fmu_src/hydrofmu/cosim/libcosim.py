@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .master import Result
+from .master import Result, run_settings
 
 NS = 1_000_000_000
 
@@ -60,7 +60,8 @@ def run(folder, stop=None, step=None, record=None):
     for j, col in enumerate(record):
         name, var = col.split(".", 1)
         values[:, j] = _samples(series, index[name], refs[name][var], n)
-    return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step, manifest["dynamics"])
+    return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step, manifest["dynamics"],
+                  run_settings(manifest, step, "jacobi", stop))
 
 
 def _samples(series, slave, ref, n):

@@ -34,6 +34,7 @@ class Result:
     algorithm: str
     step: float
     dynamics: dict = None  # body -> [dynamics instance, variable prefix]
+    settings: dict = None  # preset and knobs of the run (``run_settings``)
 
     def __getitem__(self, column):
         return self.values[:, self.columns.index(column)]
@@ -54,6 +55,34 @@ class Result:
             w.writerow(["time"] + self.columns)
             for t, row in zip(self.time, self.values):
                 w.writerow([repr(float(t))] + [repr(float(x)) for x in row])
+
+
+def run_settings(manifest, step=None, algorithm=None, stop=None):
+    """The knobs a run uses: the scene's (its preset's, unless the scene set them) with
+    the run's own step/algorithm/stop on top.  ``set``: knobs not from the preset."""
+    cfg = manifest["run"]
+    out = {k: cfg.get(k) for k in ("preset", "step", "stop", "algorithm", "substep", "load_hold")}
+    out["set"] = list(cfg.get("set", []))
+    for key, value in (("step", step), ("algorithm", algorithm), ("stop", stop)):
+        if value is not None and value != out[key]:
+            out[key] = value
+            out["set"].append(f"{key} (run)")
+    out["couplings"] = manifest.get("couplings", {})
+    return out
+
+
+def describe(settings):
+    """One line naming the preset and every knob of a run."""
+    memory = "; ".join(
+        f"{name}: {c['method']}" + (f" tol {c['tolerance']:g}" if c["method"] == "state_space" and not c["order"]
+                                    else f" order {c['order']}" if c["order"] else "")
+        + (f", memory {c['memory_length']:g} s" if c["memory_length"] else "")
+        + (f" (set: {', '.join(c['set'])})" if c["set"] else "")
+        for name, c in settings["couplings"].items())
+    return (f"preset {settings['preset'] or 'none'}: step {settings['step']:g} s, {settings['algorithm']}, "
+            f"{settings['load_hold']} load hold, substep {settings['substep']:g} s"
+            + (f"; set by the scene/run: {', '.join(settings['set'])}" if settings["set"] else "")
+            + (f"; memory {memory}" if memory else ""))
 
 
 class Instance:
@@ -164,6 +193,9 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         reads = [(system.instances[k].fmu, np.array(cols), np.array(vrs)) for k, (cols, vrs) in by_inst.items()]
         values = np.empty((n + 1, len(record)))
         progress = n > 2000 if progress is None else progress
+        if progress:
+            sys.stderr.write(f"{system.manifest['scene']}: "
+                             f"{describe(run_settings(system.manifest, step, algorithm, stop))}\n")
         tty = sys.stderr.isatty()
         every = max(1, n // (20 if tty else 4))  # a live line on a terminal, four lines in a log
 
@@ -197,6 +229,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 sys.stderr.flush()
         if progress and tty:
             sys.stderr.write("\n")
-        return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"])
+        return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"],
+                      run_settings(system.manifest, step, algorithm, stop))
     finally:
         system.free()

@@ -211,3 +211,33 @@ def _at(line, index):
         if count > index or not more:
             return Line(line.path, number, line.text)
     return line
+
+
+def format_coupling(name, body_a, body_b, added_mass=None, kernels=None, timdel=None,
+                    text=("written by hydrofmu", "SI units")):
+    """Lines of one `HYDRodynamic COUPling DATA` group (the layout ``read_couplings`` reads).
+
+    added_mass: 6×6 [kg, kg·m, kg·m²] or None; kernels: {(IDOF_A, IDOF_B): samples at
+    s = 0, TIMDEL, …} (1-based) with ``timdel`` [s]; at least one of the two is given.
+    """
+    lines = [GROUP, name, *text, body_a, body_b]
+    if added_mass is not None:
+        lines.append(ADDED_MASS)
+        lines += ["  " + "  ".join(f"{x:.9e}" for x in row) for row in np.asarray(added_mass, float).reshape(6, 6)]
+    if kernels:
+        lines += [RETARDATION, repr(float(timdel)), ELEMENTS]
+        for (i, j), h in kernels.items():
+            h = np.asarray(h, float).ravel()
+            lines.append(f"{h.size} {i} {j}")
+            rows = [" ".join(f"{x:.9e}" for x in h[k:k + 6]) for k in range(0, h.size, 6)]
+            lines += [r + " &" for r in rows[:-1]] + rows[-1:]
+    return lines
+
+
+def write_couplings(path, groups, header="SIMO hydrodynamic coupling data (SI units)"):
+    """Write groups of ``format_coupling`` lines to a deck file; returns its path."""
+    text = [f"' {header}"]
+    for g in groups:
+        text += ["'"] + list(g)
+    Path(path).write_text("\n".join(text) + "\n")
+    return Path(path)

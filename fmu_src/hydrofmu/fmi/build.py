@@ -381,6 +381,8 @@ def build_scene(scene, outdir, shim=True, log=print):
                           for s in specs},
             "dynamics": {body: list(v) for body, v in dyn_of.items()},
             "stability_indicators": indicators,
+            "couplings": {c.name: {"method": c.method, "tolerance": c.tolerance, "order": c.order,
+                                   "memory_length": c.memory_length, "set": c.set} for c in scene.couplings},
             "order": [s["instance"] for s in specs],
             "connections": conns,
         }
