@@ -54,7 +54,29 @@ a_B,k ≈ −(M_B + A_BB)⁻¹·A_BA·a_A,k−1, so a_A,k+1 = G·a_A,k−1 with
     G = (M_A + A_AA)⁻¹·A_AB·(M_B + A_BB)⁻¹·A_BA      (physics.coupling.stability_indicator)
 
 an alternating mode growing by ρ(G) every two steps (√ρ(G) per step): ρ(G) > 1
-diverges whatever the step.  ``cross_body_run`` measures it with the Coupling kernel.
+diverges whatever the step.
+
+ρ(G) < 1 is necessary, not sufficient.  The exact map (``cross_body_theory``: as in
+section 1, on (x_A, v_A, x_B, v_B, F_A, F_B), translations) shows a second, slow
+instability: the cross inertia load arrives about one step late, F_A(t) ≈ −c·a_B(t − τ),
+τ ≈ h, and −c·a_B(t − τ) ≈ −c·a_B(t) + c·τ·ȧ_B(t).  On the anti-phase mode of two equal
+bodies (x_B = −x_A, mass M − c, ω_a² = K/(M − c), c = A_AB) ȧ_B = +ω_a²·ẋ_A, a damping
+of −c·τ·ω_a²: negative.  (On the in-phase mode, and on a body's own explicit added mass
+of section 1, the sign is positive: that is why section 1 is stable below A/M = 1.)
+Undamped, the per-step growth is then
+
+    ln ρ_step ≈ c·ω_a²·τ·h / (2·(M − c)) = √ρ·ω0²·h² / (2·(1 − √ρ)²)    (equal bodies, ρ = ρ(G))
+
+(exact map, ρ(G) = 0.8, T = 20 s: ρ_step − 1 = 3.75e-6 at h = 1e-3 s, i.e. τ = 0.95·h;
+0.0199 at h = 0.1 s, where the rate saturates).  So without damping the explicit cross
+coupling is unstable at every step, with a growth rate ∝ h; physical damping ζ (of each
+dry body, on the anti-phase mode ζ/√(1 − √ρ)) stabilises it below
+
+    h_max ≈ ζ·(1 − √ρ)·T / (π·√ρ)              (equal bodies, τ = h)
+
+which the exact map puts 1.01–1.45 times higher (ρ(G) = 0.95 … 0.2, ζ = 1–5 %), e.g.
+h_max = 0.016 s at ρ(G) = 0.8, 0.062 s at 0.5 (ζ = 2 %, T = 20 s): the explicit cross
+coupling needs steps far below the periods as ρ(G) approaches 1.
 
 3. Quadratic drag at large steps and speeds
 -------------------------------------------
@@ -172,10 +194,10 @@ def added_mass_theory(ratio, dt, period=20.0, zeta=0.0, mode="explicit"):
     ``mode``: 'explicit' (−A·a applied one step late) or 'export' (A in the mass matrix).
     Valid as "unstable iff A/M > 1" for dt ≪ period (here dt ≤ period/20); see the module
     docstring for damped long steps where A/M slightly above 1 is stable."""
-    k, c = _spring(period, zeta)
-    m = 1.0 + ratio if mode == "export" else 1.0
     if mode not in ("explicit", "export"):
         raise ValueError(f"mode must be 'explicit' or 'export', not {mode!r}")
+    k, c = _spring(period, zeta)
+    m = 1.0 + ratio if mode == "export" else 1.0
     e = expm(np.array([[0.0, 1.0, 0.0], [-k / m, -c / m, 1.0 / m], [0.0, 0.0, 0.0]]) * dt)
     if mode == "export":
         return float(np.max(np.abs(np.linalg.eigvals(e[:2, :2]))))
@@ -191,11 +213,11 @@ def added_mass_run(ratio, dt, mode, n_steps=400, period=20.0, zeta=0.0, mass=MAS
     reference point with AMX = AMY = AMZ = ``ratio``·M (no drag, AM = AE = 0), started
     with heave velocity ``v0`` [m/s].  ``mode``: 'explicit' (BodyLoads applies −A·a) or
     'export' (A in the RigidBody's added_mass).  RK4 substeps ≤ min(dt, period/50)."""
+    if mode not in ("explicit", "export"):
+        raise ValueError(f"mode must be 'explicit' or 'export', not {mode!r}")
     a = ratio * mass
     point = LumpedBody("point", [0.0, 0.0, 0.0], added_mass=[a, a, a])
     loads = BodyLoads([point], explicit=(mode == "explicit"))
-    if mode not in ("explicit", "export"):
-        raise ValueError(f"mode must be 'explicit' or 'export', not {mode!r}")
     k, c = _spring(period, zeta, mass)
     added = None if loads.explicit else loads.mass_matrix(Motion())
     body = _oscillator(mass, k, c, added, [0.0, 0.0, v0, 0.0, 0.0, 0.0], min(dt, period / 50.0))
@@ -236,8 +258,8 @@ def plot_added_mass_map(result, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     ratios, steps = result["ratios"], result["steps"]
-    dense_r = np.geomspace(ratios.min() / 2, ratios.max() * 2, 60)
-    dense_h = np.geomspace(steps.min() / 2, steps.max() * 2, 40)
+    dense_r = np.union1d(np.geomspace(ratios.min() / 2, ratios.max() * 2, 32), [1.0])  # the kink
+    dense_h = np.geomspace(steps.min() / 2, steps.max() * 2, 20)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharey=True)
     for ax, mode in zip(axes, ("explicit", "export")):
         rho = np.array([[added_mass_theory(r, h, result["period"], result["zeta"], mode) for h in dense_h]
@@ -255,7 +277,8 @@ def plot_added_mass_map(result, path):
         ax.set_xlabel("communication step [s]")
         ax.set_title(f"{mode} added mass (T = {result['period']:g} s, ζ = {result['zeta']:g})")
         ax.grid(True, which="major", alpha=0.3)
-        ax.legend(loc="lower left", fontsize=8)
+        ax.set_ylim(ratios.min() / 3, ratios.max() * 40)
+        ax.legend(loc="upper center", ncol=3, fontsize=7, handletextpad=0.3, columnspacing=0.8)
     axes[0].set_ylabel("A / M")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -264,34 +287,74 @@ def plot_added_mass_map(result, path):
 
 
 # -- 2. explicit cross-body added mass ------------------------------------------------
+def _translational(matrix, field):
+    m = np.zeros((6, 6)) if matrix is None else np.asarray(matrix, float)
+    if np.any(m[3:]) or np.any(m[:, 3:]):
+        raise ValueError(f"{field}: only translational blocks are supported (rotational rows/columns must be 0)")
+    return m[:3, :3]
+
+
+def cross_body_theory(cross, mass_a=MASS, mass_b=MASS, self_a=None, self_b=None, dt=0.1, period=20.0,
+                      zeta=0.0):
+    """Spectral radius per step of the exact linear co-simulation map of ``cross_body_run``
+    (Gauss–Seidel, translations; module docstring, section 2).  Body X: mass matrix
+    m·1 + A_XX (3×3), springs K = m·(2π/period)², dampers 2·zeta·m·(2π/period), both per
+    translation; loads F_A = −A_AB·a_B, F_B = −A_ABᵀ·a_A with a from the state and the
+    load held over the previous step.  ``cross``, ``self_a``, ``self_b``: 6×6 whose rotational
+    rows and columns are zero."""
+    c = _translational(cross, "cross")
+    omega = 2.0 * math.pi / period
+    blocks = []
+    for m, own in ((mass_a, self_a), (mass_b, self_b)):
+        mm = m * np.eye(3) + _translational(own, "self added mass")
+        k, d = m * omega ** 2 * np.eye(3), 2.0 * zeta * m * omega * np.eye(3)
+        inv = np.linalg.inv(mm)
+        gen = np.zeros((9, 9))
+        gen[:3, 3:6] = np.eye(3)
+        gen[3:6] = np.hstack([-inv @ k, -inv @ d, inv])
+        blocks.append((expm(gen * dt)[:6], inv, k, d))
+    # state z = [x_A, v_A, x_B, v_B, F_A, F_B] (3 each)
+    s = np.zeros((18, 18))
+    for i, (e, _, _, _) in enumerate(blocks):
+        rows = slice(6 * i, 6 * i + 6)
+        s[rows, 6 * i:6 * i + 6], s[rows, 12 + 3 * i:15 + 3 * i] = e[:, :6], e[:, 6:]
+    acc = []
+    for i, (_, inv, k, d) in enumerate(blocks):   # a' = M⁻¹·(F − K·x' − D·v')
+        f_held = np.zeros((3, 18))
+        f_held[:, 12 + 3 * i:15 + 3 * i] = np.eye(3)
+        acc.append(inv @ (f_held - k @ s[6 * i:6 * i + 3] - d @ s[6 * i + 3:6 * i + 6]))
+    s[12:15], s[15:18] = -c @ acc[1], -c.T @ acc[0]
+    return float(np.max(np.abs(np.linalg.eigvals(s))))
+
+
 def cross_body_run(cross, mass_a=MASS, mass_b=MASS, self_a=None, self_b=None, dt=0.1, n_steps=400,
-                   period=20.0, v0=1.0, algorithm="gauss-seidel"):
+                   period=20.0, zeta=0.0, v0=1.0, algorithm="gauss-seidel"):
     """Growth factor of two bodies coupled by the cross added mass ``cross`` = A_AB
     (6×6, load on A per acceleration of B; B gets A_ABᵀ), applied explicitly through
     physics.coupling.Coupling.acceleration_load from the neighbour's acceleration output.
     Each body: RigidBody of mass ``mass_a``/``mass_b`` [kg] (gyration radius 10 m), its own
     added mass ``self_a``/``self_b`` (6×6) in its mass matrix, springs of natural period
-    ``period`` [s] for the dry body.  A starts with velocity ``v0`` [m/s] in surge, sway and
-    heave, B at rest.  Growth: max over the last quarter of max(|x|/X, |v|/v0, |F|/(K·X)),
-    X = v0·T/(2π), over both bodies and all translations; inf if it diverged."""
+    ``period`` [s] and damping ratio ``zeta`` for the dry body.  A starts with velocity
+    ``v0`` [m/s] in surge, sway and heave, B at rest.  Growth: max over the last quarter of
+    max(|x|/X, |v|/v0, |F|/(K·X)), X = v0·T/(2π), over both bodies and all translations;
+    inf if it diverged."""
     data = SimpleNamespace(name="AB", body_a="A", body_b="B", added_mass=np.asarray(cross, float),
                            timdel=1.0, kernels={})
     coupling = Coupling(data)
     omega = 2.0 * math.pi / period
     sub = min(dt, period / 50.0)
-    a = _oscillator(mass_a, mass_a * omega ** 2, added=self_a, velocity0=[v0] * 3 + [0.0] * 3, max_substep=sub)
-    b = _oscillator(mass_b, mass_b * omega ** 2, added=self_b, max_substep=sub)
+    bodies = [_oscillator(m, m * omega ** 2, 2.0 * zeta * m * omega, own, v, sub)
+              for m, own, v in ((mass_a, self_a, [v0] * 3 + [0.0] * 3), (mass_b, self_b, None))]
     x_scale = v0 / omega
-    scales = [(bd, bd.stiffness[0, 0] * x_scale) for bd in (a, b)]
 
     def loads(motions):
         return [coupling.acceleration_load("A", motions[1].acceleration),
                 coupling.acceleration_load("B", motions[0].acceleration)]
 
     def norm(held):
-        return max(max(np.abs(bd.position).max() / x_scale, np.abs(bd.velocity[:3]).max() / v0,
-                       np.abs(f[:3]).max() / fs) for (bd, fs), f in zip(scales, held))
-    return _run_growth([a, b], loads, dt, n_steps, algorithm, norm)
+        return max(max(np.abs(b.position).max() / x_scale, np.abs(b.velocity[:3]).max() / v0,
+                       np.abs(f[:3]).max() / (b.stiffness[0, 0] * x_scale)) for b, f in zip(bodies, held))
+    return _run_growth(bodies, loads, dt, n_steps, algorithm, norm)
 
 
 # -- 3. quadratic drag -----------------------------------------------------------------

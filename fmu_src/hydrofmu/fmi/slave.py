@@ -241,11 +241,7 @@ class LoadSlave(ArraySlave):
             for c in self.couplings:
                 self.add_mass_export(f"{c['cfg']['name']}.mass_matrix", np.asarray(c["cfg"]["mass"]))
         self.finish_registration()
-        self.time = 0.0
         self.stale = True
-
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self.time = start_time
 
     def exit_initialization_mode(self):
         for c in self.couplings:
@@ -258,8 +254,7 @@ class LoadSlave(ArraySlave):
             if d["kernels"]:
                 model = Coupling(data, cfg["method"], cfg["tolerance"], cfg["order"], cfg["memory_length"],
                                  v0_a=v0, v0_b=v0)
-                c["memory"] = FeedthroughMemory(model.memory[cfg["side"] if not cfg["self"] else "A"],
-                                                self.time)
+                c["memory"] = FeedthroughMemory(model.memory[cfg["side"] if not cfg["self"] else "A"])
         self.stale = True
 
     def evaluate(self):
@@ -273,7 +268,7 @@ class LoadSlave(ArraySlave):
         for c in self.couplings:
             load = np.zeros(6)
             if c["memory"] is not None:
-                load = c["memory"].force(self.time, self.values[c["velocity"]])
+                load = c["memory"].force(self.values[c["velocity"]])
             if c["acceleration"] is not None:
                 load = load - c["mass"] @ self.values[c["acceleration"]]
             self.values[c["force"]] = load
@@ -283,16 +278,13 @@ class LoadSlave(ArraySlave):
     def advance(self, t, dt):
         for c in self.couplings:
             if c["memory"] is not None:
-                c["memory"].commit(t, self.values[c["velocity"]])
-        self.time = t + dt
+                c["memory"].commit(self.values[c["velocity"]], dt)
         self.stale = bool(self.couplings)  # memory outputs move with time
 
     def physics_state(self):
-        return {"time": self.time,
-                "memory": [None if c["memory"] is None else c["memory"].state() for c in self.couplings]}
+        return {"memory": [None if c["memory"] is None else c["memory"].state() for c in self.couplings]}
 
     def set_physics_state(self, state):
-        self.time = state["time"]
         for c, s in zip(self.couplings, state["memory"]):
             if s is not None:
                 c["memory"].set_state(s)
@@ -436,31 +428,31 @@ class ConnectorSlave(ArraySlave):
 
 class FeedthroughMemory:
     """A retardation-memory evaluator seen through FMI: its output follows the current
-    input before the step commits it.  The pending interval [t_commit, t] (velocity
-    linear, ending at the current input) is evaluated by the evaluator's ``peek``, which
-    leaves its history alone; ``commit`` moves it, reusing the peek when the step
-    confirms the same interval."""
+    input before the step commits it.  The pending interval is the last communication
+    step (velocity linear over it, ending at the current input); the evaluator's ``peek``
+    evaluates it without moving, and ``commit`` moves it (reusing the peek) when the next
+    step starts.  Intervals are the master's step sizes themselves, never differences of
+    accumulated times, so a constant step stays bit-identical (and cached weights valid)."""
 
-    def __init__(self, evaluator, t0):
-        self.ev, self.t = evaluator, t0
+    def __init__(self, evaluator):
+        self.ev, self.pending = evaluator, 0.0
 
-    def force(self, t, v):
-        dt = t - self.t
-        if dt <= 0.0:
+    def force(self, v):
+        if self.pending <= 0.0:
             return np.asarray(self.ev.force, dtype=float).copy()
-        return self.ev.peek(dt, v)
+        return self.ev.peek(self.pending, v)
 
-    def commit(self, t, v):
-        dt = t - self.t
-        if dt > 0.0:
-            self.ev.advance(dt, v)
-            self.t = t
+    def commit(self, v, dt_next):
+        """Close the pending interval at velocity v; the next one is dt_next long."""
+        if self.pending > 0.0:
+            self.ev.advance(self.pending, v)
+        self.pending = float(dt_next)
 
     def state(self):
-        return {"t": self.t, "ev": self.ev.state()}
+        return {"pending": self.pending, "ev": self.ev.state()}
 
     def set_state(self, state):
-        self.t = state["t"]
+        self.pending = state["pending"]
         self.ev.set_state(state["ev"])
 
 

@@ -393,11 +393,16 @@ class StateSpace:
         self._inp, self._out = np.array(inp, int), np.array(out, int)
         self.order = sum(f.order for f in self.fits.values())   # real states
         self._z = np.zeros(len(mu), complex)
-        # F = −Re(Γ·z) as one product: Γ[i, mode] = γ of the modes that load component i
-        self._gain = np.zeros((self.shape[0], len(mu)), complex)
-        self._gain[self._out, np.arange(len(mu))] = -self._gam
+        # Products on real views of the complex modal state (z as [Re z₀, Im z₀, Re z₁, …]),
+        # so each step is two small real matrix products: F = −Re(Γ·z) = gain·z_real.
+        m = len(mu)
+        self._gain = np.zeros((self.shape[0], 2 * m))
+        self._gain[self._out, 2 * np.arange(m)] = -self._gam.real
+        self._gain[self._out, 2 * np.arange(m) + 1] = self._gam.imag
+        self._u = np.zeros(2 * self.shape[1])       # [v_old, v_new]
         self._v = _start(self.shape, v0)
         self._cache = OrderedDict()
+        self._last_dt, self._last = None, None
         self._peeked = None
         self.force = np.zeros(self.shape[0])
 
@@ -406,37 +411,54 @@ class StateSpace:
         return self._v.copy()
 
     def _discrete(self, dt):
-        """(e^{μdt}, dt·(φ₁ − φ₂), dt·φ₂): z_new = e·z + p·v_old + q·v_new per mode."""
+        """(e^{μdt}, B) for a step dt: z_new = e·z + B·[v_old; v_new], with B (real view,
+        2·modes × 2·n_in) holding dt·(φ₁ − φ₂) on v_old and dt·φ₂ on v_new of each mode's input."""
+        if dt == self._last_dt:                   # the usual case: a constant step
+            return self._last
         key = float(dt)
         if key not in self._cache:
             x = self._mu * dt
             p1, p2 = _phi(x)
-            self._cache[key] = (np.exp(x), dt * (p1 - p2), dt * p2)
+            m, n_in = len(x), self.shape[1]
+            b = np.zeros((m, 2 * n_in), complex)
+            b[np.arange(m), self._inp] = dt * (p1 - p2)
+            b[np.arange(m), n_in + self._inp] = dt * p2
+            real = np.empty((2 * m, 2 * n_in))
+            real[0::2], real[1::2] = b.real, b.imag
+            self._cache[key] = (np.exp(x), real)
             if len(self._cache) > 16:
                 self._cache.popitem(last=False)
         self._cache.move_to_end(key)
-        return self._cache[key]
+        self._last_dt, self._last = key, self._cache[key]
+        return self._last
+
+    def _step(self, dt, v_new):
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0, got {dt}")
+        v_new = np.array(v_new, dtype=float)
+        if v_new.shape != self._v.shape:
+            v_new = v_new.reshape(self._v.shape)
+        z, force = self._z, self.force
+        if self._mu.size:
+            e, b = self._discrete(dt)
+            u = self._u
+            u[:v_new.size], u[v_new.size:] = self._v, v_new
+            z = e * z + (b @ u).view(complex)
+            force = self._gain @ z.view(float)
+        return float(dt), v_new, z, force
 
     def peek(self, dt, v_new):
         """The memory load F(t + dt) if the velocity reached v_new at t + dt, without
         moving (a following ``advance`` with the same arguments reuses the result)."""
-        if not dt > 0:
-            raise ValueError(f"dt must be > 0, got {dt}")
-        v_new = np.array(v_new, float).reshape(self.shape[1])
-        z, force = self._z, self.force
-        if self._mu.size:
-            e, p, q = self._discrete(dt)
-            z = e * self._z + p * self._v[self._inp] + q * v_new[self._inp]
-            force = (self._gain @ z).real
-        self._peeked = (float(dt), v_new, z, force)
-        return force.copy()
+        self._peeked = self._step(dt, v_new)
+        return self._peeked[3].copy()
 
     def advance(self, dt, v_new):
         """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
         p = self._peeked
         if p is None or p[0] != dt or not np.array_equal(p[1], v_new):
-            self.peek(dt, v_new)
-        _, self._v, self._z, self.force = self._peeked
+            p = self._step(dt, v_new)
+        _, self._v, self._z, self.force = p
         self._peeked = None
         return self.force.copy()
 
