@@ -13,7 +13,7 @@ METHODS = ["convolution", "state_space"]
 
 def random_data(rng, timdel=0.2, n=30, blocks=((1, 1), (1, 5), (2, 6), (3, 3), (5, 1), (4, 2))):
     t = timdel * np.arange(n)
-    kernels = {(i, j): rng.normal() * np.exp(-rng.uniform(0.2, 0.6) * t) * np.cos(rng.uniform(0.3, 1.2) * t)
+    kernels = {(i, j): rng.normal() * np.exp(-rng.uniform(0.8, 1.5) * t) * np.cos(rng.uniform(0.3, 1.2) * t)
                for i, j in blocks}
     return CouplingData("c", ("", ""), "b1", "b2", rng.normal(size=(6, 6)) * 1e5, timdel, kernels)
 
@@ -52,9 +52,11 @@ def test_kernel_element_rule_steady_velocity(method):
         f_b = c.advance("B", 0.5, np.eye(6)[2] * 1.5)          # A's heave drives B's yaw
         f_a = c.advance("A", 0.5, np.eye(6)[5] * -0.4)         # B's yaw drives A's heave
     # convolution: the piecewise-linear kernel's area; state space: ∫ 4e4·e^(−2t) dt = 2e4
+    # (the fit sees the zero tail after the kernel's end, h(4.9)/h(0) = 5.5e-5: its floor)
     area = trapezoid(h, timdel) if method == "convolution" else 2.0e4
-    np.testing.assert_allclose(f_b, -area * 1.5 * np.eye(6)[5], rtol=1e-9, atol=1e-9 * area)
-    np.testing.assert_allclose(f_a, area * 0.4 * np.eye(6)[2], rtol=1e-9, atol=1e-9 * area)
+    rtol = 1e-9 if method == "convolution" else 1e-4
+    np.testing.assert_allclose(f_b, -area * 1.5 * np.eye(6)[5], rtol=rtol, atol=rtol * area)
+    np.testing.assert_allclose(f_a, area * 0.4 * np.eye(6)[2], rtol=rtol, atol=rtol * area)
 
 
 def test_short_kernel_area_by_hand():

@@ -109,7 +109,9 @@ def test_converges_to_analytic_response(method, kind):
 def test_state_space_is_exact_at_order_one():
     a, c, timdel = 0.7, 3.0, 0.05
     fit = realise(c * np.exp(-a * timdel * np.arange(300)), timdel)
-    assert fit.order == 1 and fit.error < 1e-9
+    # the fit also sees the zero tail after the last sample: its floor is the jump there,
+    # e^(−a·T) = 2.8e-5 of h(0)
+    assert fit.order == 1 and fit.error < 2 * np.exp(-a * timdel * 299)
     assert fit.A[0, 0] == pytest.approx(-a, abs=1e-6)
     assert fit.C[0] * fit.B[0] == pytest.approx(c, abs=1e-6)
 

@@ -88,10 +88,18 @@ def fmus(tmp_path_factory):
 
 # fmpy's logger proxy forwards to ONE process-global Python logger (the last one given
 # to addLoggerProxy), also for FMUs using fmpy's default callbacks.  A test that
-# proxies its own logger must point the proxy back at a logger that lives forever,
-# else a later FMU that logs calls a freed ctypes thunk and the process crashes.
+# proxies its own logger must point the proxy back at a complete callback structure that
+# lives for the whole process (fmpy's own defaultCallbacks cannot serve: its logger field
+# already is the proxy, which would then call itself), else a later FMU that logs calls a
+# freed ctypes thunk and the process crashes.
+def _print_log(env, instance, status, category, message):
+    print(f"[{status}] {message.decode('utf-8', 'replace')}")
+
+
 _KEEP = fmi2CallbackFunctions()
-_KEEP.logger = fmi2CallbackLoggerTYPE(fmpy.fmi2.printLogMessage)
+_KEEP.logger = fmi2CallbackLoggerTYPE(_print_log)
+_KEEP.allocateMemory = fmpy.fmi2.fmi2CallbackAllocateMemoryTYPE(fmpy.fmi2.calloc)
+_KEEP.freeMemory = fmpy.fmi2.fmi2CallbackFreeMemoryTYPE(fmpy.fmi2.free)
 
 
 @pytest.fixture

@@ -22,7 +22,8 @@ import json
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
 
 @dataclass
@@ -96,7 +97,20 @@ class Instance:
         self.causality = {v.name: v.causality for v in self.md.modelVariables}
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate(loggingOn=False)  # fmpy's default logger prints FMU errors
+        # Our own logger, given straight to the FMU: fmpy's default goes through a process-
+        # global proxy that any other fmpy user may repoint.  hydrofmu's shim sends literal
+        # text with '%' doubled (the message is a printf format for C hosts).
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+
+    @staticmethod
+    def _log(env, instance, status, category, message):
+        label = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")[status] if 0 <= status < 6 else status
+        text = (message or b"").decode("utf-8", "replace").replace("%%", "%")
+        sys.stderr.write(f"[{label}] {text}\n")
 
     def outputs(self):
         return [n for n, c in self.causality.items() if c == "output"]
@@ -166,12 +180,14 @@ class System:
         self.instances = {}
 
 
-def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None):
+def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
+        on_step=None):
     """Run a built scene; returns a Result.
 
     ``record``: 'instance.variable' columns (default: every output of every FMU).
     ``parameters``: {'instance.variable': value} set in initialization mode.
     ``progress``: print a progress line to stderr (default: when more than 2000 steps).
+    ``on_step``: called with the step count after each communication step (benchmarks).
     """
     system = System(folder, parameters)
     try:
@@ -221,6 +237,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                     inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
                 system.resolve(order)
                 sample(k + 1)
+            if on_step is not None:
+                on_step(k + 1)
             if progress and (k + 1) % every == 0:
                 elapsed = clock.perf_counter() - t0
                 line = (f"{system.manifest['scene']}: t = {(k + 1) * step:.1f} s of {stop:g} s "

@@ -147,6 +147,7 @@ class ArraySlave(Fmi2Slave):
     def set_real(self, vrs, values):
         self.values[vrs] = values
         self.stale = True
+        self.error = None   # new inputs: the next evaluation checks them afresh
 
     def check_finite(self, slices):
         """Record an error naming the first non-finite input; True if all are finite."""
@@ -341,11 +342,27 @@ class DynamicsSlave(ArraySlave):
         self.bodies = bodies
         if self.cross:
             self.solver = CoupledBodies(bodies, {k: v[s].reshape(6, 6).copy() for k, s in self.cross.items()})
+        # the initial acceleration, under the loads the inputs hold now
+        if self.check_finite(self.load_inputs):
+            for body, load in zip(bodies, self._loads()):
+                body.step(0.0, load)
+            self._publish()
+        self.error = None
+
+    def _loads(self):
+        return np.array([sum(self.values[s] for s in part["loads"]) for part in self.parts])
+
+    def _publish(self):
+        accelerations = self.solver.accelerations() if self.solver else [self.bodies[0].acceleration]
+        v = self.values
+        for part, body, acc in zip(self.parts, self.bodies, accelerations):
+            v[part["position"]], v[part["attitude"]] = body.position, body.attitude
+            v[part["velocity"]], v[part["acceleration"]] = body.velocity, acc
 
     def advance(self, t, dt):
         if not self.check_finite(self.load_inputs):
             return
-        loads = np.array([sum(self.values[s] for s in part["loads"]) for part in self.parts])
+        loads = self._loads()
         rates = None
         if self.config.get("load_hold") == "linear":
             # first-order hold: extrapolate the load with its slope over the last step
@@ -354,14 +371,9 @@ class DynamicsSlave(ArraySlave):
             self.last_loads = (loads, dt)
         if self.solver is not None:
             self.solver.step(dt, loads, rates)
-            accelerations = self.solver.accelerations()
         else:
             self.bodies[0].step(dt, loads[0], None if rates is None else rates[0])
-            accelerations = [self.bodies[0].acceleration]
-        v = self.values
-        for part, body, acc in zip(self.parts, self.bodies, accelerations):
-            v[part["position"]], v[part["attitude"]] = body.position, body.attitude
-            v[part["velocity"]], v[part["acceleration"]] = body.velocity, acc
+        self._publish()
 
     def physics_state(self):
         if not hasattr(self, "bodies"):

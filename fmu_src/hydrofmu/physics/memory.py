@@ -277,24 +277,26 @@ def _assemble(poles):
 def realise(h, timdel, tol=0.01, order=None, max_order=40):
     """Realise a sampled kernel h(k·TIMDEL), k = 0…N−1, as h(t) ≈ C·exp(A·t)·B.
 
+    The kernel is zero after its last sample (the convention ``Convolution`` follows), so
+    the fit sees it followed by N − 1 zero samples: a realisation that goes on past the end
+    shows up in its error instead of silently changing the memory load.
     Poles come from the eigenvalue realisation algorithm (ERA: SVD of the Hankel matrix of
-    the samples, rows at a stride so they span half the kernel, shifted by one sample);
-    the amplitudes are then fitted by least squares to all samples.  Unstable poles are
-    reflected into the left half plane (σ → −max(|σ|, 1/T), T = (N−1)·TIMDEL) and poles on
-    the negative real axis of the discrete plane (a pure sample-to-sample alternation) are
-    dropped, before that refit, so every realisation is stable.
+    those samples, rows at a stride so they span half the window, shifted by one sample).
+    Unstable poles are reflected into the left half plane (σ → −max(|σ|, 1/T), T the
+    window) and poles on the negative real axis of the discrete plane (a pure sample-to-
+    sample alternation) are dropped, so every realisation is stable.  The amplitudes are
+    then fitted by least squares to all samples, the zero tail included.
     ``order``: the ERA order to use (the realisation may come out smaller when modes are
-    dropped); else the smallest order whose normalised RMS error is ≤ ``tol`` (or the best
-    found up to ``max_order``).  Returns a ``Realisation`` (check ``error`` against tol).
+    dropped); else the smallest order whose error ‖ĥ − h‖/‖h‖ over the window (samples
+    and zero tail) is ≤ ``tol`` (or the best found up to ``max_order``).  Returns a
+    ``Realisation`` (check ``error`` against tol).
     """
     h = np.asarray(h, float).ravel()
-    if h.size == 2:
-        h = np.append(h, 0.0)        # the Hankel matrix needs three samples
+    if h.size < 2 or not np.any(h):   # one sample spans no time: no memory, as in Convolution
+        return Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 0.0)
+    h = np.concatenate([h, np.zeros(h.size - 1)])
     t = timdel * np.arange(h.size)
-    rms = np.sqrt(np.mean(h ** 2)) if h.size > 1 else 0.0
-    empty = Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 0.0 if rms == 0 else 1.0)
-    if rms == 0.0:                   # (one sample spans no time: no memory, as in Convolution)
-        return empty
+    norm = np.linalg.norm(h)
     rows = min(100, (h.size - 1) // 2)
     stride = max(1, (h.size - 1) // (2 * rows))
     ncol = h.size - 1 - (rows - 1) * stride
@@ -304,7 +306,7 @@ def realise(h, timdel, tol=0.01, order=None, max_order=40):
     shifted = u.T @ h[i + 1] @ vt.T
     rank = int(np.sum(sv > sv[0] * 1e-12))
     orders = [min(order, rank)] if order is not None else range(1, min(max_order, rank) + 1)
-    best = empty
+    best = Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0)
     for r in orders:
         si = 1.0 / np.sqrt(sv[:r])
         mu = np.linalg.eigvals(si[:, None] * shifted[:r, :r] * si[None, :]).astype(complex)
@@ -312,19 +314,21 @@ def realise(h, timdel, tol=0.01, order=None, max_order=40):
         lam = np.log(mu[keep]) / timdel
         bad = lam.real >= 0                          # reflect into the left half plane
         lam[bad] = -np.maximum(lam[bad].real, 1.0 / t[-1]) + 1j * lam[bad].imag
-        fit = _fit(lam, t, h, rms)
-        if fit.error < best.error:
-            best = fit
+        if lam.size:
+            fit = _fit(lam, t, h, norm)
+            if fit.error < best.error:
+                best = fit
         if best.error <= tol and order is None:
             break
     return best
 
 
-def _fit(lam, t, h, rms):
+def _fit(lam, t, h, norm):
+    """Amplitudes for poles ``lam``: least squares on the samples h(t) (zero tail included)."""
     a = _assemble(lam)
     phi = _basis(a, t)
     c = np.linalg.lstsq(phi, h, rcond=None)[0]
-    err = np.sqrt(np.mean((phi @ c - h) ** 2)) / rms
+    err = np.linalg.norm(phi @ c - h) / norm
     b = np.zeros(a.shape[0])
     k = 0
     for p in lam:

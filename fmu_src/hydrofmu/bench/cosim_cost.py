@@ -1,0 +1,84 @@
+"""Whole co-simulations through fmpy: communication step against accuracy, cost against
+the number of coupled bodies, and cost per step along simulated time.
+
+All runs use ``fleet.Fleet`` (bodies coupled by SIMO interaction) in export mode; the
+error is the largest normalised RMS (``fleet.nrms``) over the moving translations against
+the monolithic scipy solution of the same Cummins equations.
+"""
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..cosim.master import run
+from ..fmi.build import build_scene
+from ..scene import load_scene
+from .fleet import Fleet, nrms
+
+# translations that really move: body 1 surge, sway, heave; body 2 sway, heave (body 2's
+# surge is driven by nothing)
+MOVING = [0, 1, 2, 7, 8]
+
+
+def _build(path, folder):
+    return build_scene(load_scene(path), folder, log=lambda *_: None)
+
+
+def step_sweep(folder, steps=(0.2, 0.1, 0.05, 0.02, 0.01), algorithms=("jacobi", "gauss-seidel"),
+               holds=("constant", "linear"), stop=60.0, method="convolution"):
+    """Rows {algorithm, load_hold, step, error, wall_s, pareto} of the two-body scene;
+    ``pareto``: no other run is both faster and more accurate."""
+    fleet, folder = Fleet(2), Path(folder)
+    rows, refs = [], {}
+    for hold in holds:
+        built = _build(fleet.scene(folder / hold, run=f'stop = {stop}\nload_hold = "{hold}"\nsubstep = 0.01',
+                                   coupling=f'method = "{method}"'), folder / hold / "fmus")
+        for algorithm in algorithms:
+            for dt in steps:
+                t0 = time.perf_counter()
+                result = run(built, step=dt, algorithm=algorithm, progress=False)
+                wall = time.perf_counter() - t0
+                if dt not in refs:
+                    refs[dt] = fleet.monolithic(result.time)
+                err = nrms(fleet.displacements(result)[:, MOVING], refs[dt][:, MOVING]).max()
+                rows.append({"algorithm": algorithm, "load_hold": hold, "step": dt,
+                             "error": float(err), "wall_s": wall})
+    for r in rows:
+        r["pareto"] = not any(o["wall_s"] < r["wall_s"] and o["error"] < r["error"] for o in rows)
+    return rows
+
+
+def _per_step(built, stop, step, chunks=1):
+    """Seconds per step of a run, in ``chunks`` equal parts of it."""
+    n = int(round(stop / step))
+    marks = [time.perf_counter()]
+    every = max(1, n // chunks)
+    run(built, stop=stop, step=step, progress=False, record=[],
+        on_step=lambda k: marks.append(time.perf_counter()) if k % every == 0 else None)
+    return np.diff(marks) / every
+
+
+def body_growth(folder, counts=(2, 4, 8), stop=20.0, step=0.05, preset="design"):
+    """Rows {bodies, couplings, fmus, ms_per_step}: every pair of bodies coupled (all-pairs
+    interaction, so couplings grow as n(n+1)/2), one load FMU per body and one coupled
+    dynamics FMU."""
+    rows = []
+    for n in counts:
+        fleet = Fleet(n)
+        built = _build(fleet.scene(Path(folder) / f"n{n}", run=f'preset = "{preset}"\nstop = {stop}',
+                                   name=f"fleet{n}"), Path(folder) / f"n{n}" / "fmus")
+        cost = _per_step(built, stop, step)[0]
+        rows.append({"bodies": n, "couplings": len(fleet.pairs()), "fmus": len(list(built.glob("*.fmu"))),
+                     "ms_per_step": 1e3 * cost})
+    return rows
+
+
+def flatness(folder, stop=1000.0, step=0.05, chunks=10, method="convolution"):
+    """Rows {t_start, t_end, us_per_step} along one long two-body run (memory fills within
+    the kernel length, 40 s, then the cost per step must stay flat)."""
+    fleet = Fleet(2)
+    built = _build(fleet.scene(Path(folder) / "long", run=f"stop = {stop}", coupling=f'method = "{method}"'),
+                   Path(folder) / "long" / "fmus")
+    cost = _per_step(built, stop, step, chunks)
+    span = stop / chunks
+    return [{"t_start": k * span, "t_end": (k + 1) * span, "us_per_step": 1e6 * c} for k, c in enumerate(cost)]
