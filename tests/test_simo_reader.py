@@ -157,3 +157,17 @@ def test_self_coupling_added_mass_must_be_symmetric(tmp_path):
     assert c.body_a == c.body_b == "B"
     raises(tmp_path, self_deck.replace("0 2 0 0 0 0", "0 2 0 0 0 7"), 10, "AM26", bodies=(),
            match="symmetric")
+
+
+def test_writer_round_trip(tmp_path):
+    """decks.simo.format_coupling/write_couplings write what read_couplings reads back."""
+    from hydrofmu.decks.simo import format_coupling, write_couplings
+    rng = np.random.default_rng(5)
+    am = rng.normal(size=(6, 6)) * 1e5
+    kernels = {(1, 1): rng.normal(size=13), (2, 6): rng.normal(size=7) * 1e3}
+    path = write_couplings(tmp_path / "w.sim", [format_coupling("AB", "A", "B", am, kernels, 0.25)])
+    got = read_couplings(path, bodies={"A", "B"})["AB"]
+    np.testing.assert_allclose(got.added_mass, am, rtol=1e-9)
+    assert got.timdel == 0.25 and set(got.kernels) == set(kernels)
+    for ij, h in kernels.items():
+        np.testing.assert_allclose(got.kernels[ij], h, rtol=1e-9)

@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | validate | demo`` (a thin layer over the library)."""
+"""Command line: ``hydrofmu build | run | validate | demo | bench`` (a thin layer over the library)."""
 import argparse
 import json
 import sys
@@ -80,6 +80,11 @@ def main(argv=None):
     d = sub.add_parser("demo", help="build every scene in models/, run each one, write CSV and PNG per scene")
     d.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
     d.add_argument("--scene", action="append", help="run only this scene (repeatable)")
+    k = sub.add_parser("bench", help="speed/accuracy benchmarks and the stability map: CSV + PNG per part")
+    k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path)
+    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "stability"),
+                   help="run only this part (repeatable)")
+    k.add_argument("--quick", action="store_true", help="small sizes: a smoke run, not the README figures")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -100,6 +105,9 @@ def main(argv=None):
                 result = run_folder(folders[name], "fmpy", csv, png)
                 print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
                       f"wrote {csv} and {png}")
+        elif args.command == "bench":
+            from .bench.run import main as bench
+            bench(args.out, args.part, args.quick)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

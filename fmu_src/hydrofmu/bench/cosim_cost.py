@@ -43,8 +43,13 @@ def step_sweep(folder, steps=(0.2, 0.1, 0.05, 0.02, 0.01), algorithms=("jacobi",
                 err = nrms(fleet.displacements(result)[:, MOVING], refs[dt][:, MOVING]).max()
                 rows.append({"algorithm": algorithm, "load_hold": hold, "step": dt,
                              "error": float(err), "wall_s": wall})
+    return pareto(rows)
+
+
+def pareto(rows, cost="wall_s", error="error"):
+    """Mark each row ``pareto``: no other row is both cheaper and more accurate."""
     for r in rows:
-        r["pareto"] = not any(o["wall_s"] < r["wall_s"] and o["error"] < r["error"] for o in rows)
+        r["pareto"] = not any(o[cost] < r[cost] and o[error] < r[error] for o in rows)
     return rows
 
 

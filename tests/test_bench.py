@@ -1,0 +1,76 @@
+"""Benchmark building blocks against independent answers: the realistic kernels against
+their analytic cosine transform, the evaluator trade-off's bookkeeping, the Pareto front,
+and the side-by-side timer."""
+import math
+
+import numpy as np
+import pytest
+
+from hydrofmu.bench import memory_cost
+from hydrofmu.bench.cosim_cost import pareto
+from hydrofmu.bench.kernels import damping_kernel, irregular_velocity
+from hydrofmu.bench.timing import per_call
+
+
+def test_own_damping_kernel_is_its_cosine_transform():
+    """B(ω) = b·x²·e^(1 − x²), x = ω/ωp: (2/π)∫B·cos ωt dω = (2/π)·b·e·ωp·(√π/8)·(2 − k²)·e^(−k²/4),
+    k = ωp·t (from ∫₀^∞ x²·e^(−x²)·cos(kx) dx = (√π/8)(2 − k²)·e^(−k²/4))."""
+    b, wp = 3.0e5, 0.8
+    t = np.linspace(0.0, 30.0, 301)
+    k = wp * t
+    exact = 2 / math.pi * b * math.e * wp * math.sqrt(math.pi) / 8 * (2 - k ** 2) * np.exp(-k ** 2 / 4)
+    np.testing.assert_allclose(damping_kernel(t, b, wp), exact, atol=1e-6 * np.abs(exact).max())
+
+
+def test_interaction_kernel_arrives_after_the_group_travel_time():
+    """cos(k·d) with k = ω²/g: stationary phase puts the echo of frequency ω at t = 2ωd/g;
+    with the damping peak near ωp the kernel's envelope peaks near 2·ωp·d/g, not at 0."""
+    wp, d = 1.0, 100.0
+    t = np.linspace(0.0, 60.0, 1201)
+    h = damping_kernel(t, 1.0, wp, distance=d)
+    t_peak = t[np.argmax(np.abs(h))]
+    assert 0.6 * 2 * wp * d / 9.81 < t_peak < 1.6 * 2 * wp * d / 9.81
+
+
+def test_irregular_velocity_has_the_requested_sea_state():
+    """Hs = 4·√m0 of the wave elevation whose velocity this is: the linear velocity of each
+    harmonic is ω·a, so its variance is Σ (ω·a)²/2 — recompute it from the samples."""
+    t = np.arange(0.0, 3600.0, 0.25)
+    v = irregular_velocity(t, hs=3.0, tp=10.0)
+    assert v.shape == (t.size, 6)
+    assert np.std(v[:, 0]) == pytest.approx(np.std(v[:, 1]), rel=0.2)   # same spectrum, other phases
+    assert 0.5 * 0.75 < np.std(v[:, 0]) < 1.2 * 0.75   # ω between 0.5 and 1.2 rad/s times σ_η = Hs/4
+    assert np.std(v[:, 3]) == pytest.approx(0.02 * np.std(v[:, 0]), rel=0.2)
+
+
+def test_tradeoff_bookkeeping():
+    rows = {r["evaluator"]: r for r in memory_cost.tradeoff(lags=600, duration=40.0, lengths=(2.0, 10.0),
+                                                           tolerances=(0.05, 0.005), orders=(), calls=50, rounds=1)}
+    full = rows["convolution full"]
+    assert full["error"] == 0.0 and full["cheaper"] == 1.0
+    # truncation: longer memory, smaller error (the kernel decays within ~20 s)
+    assert rows["convolution 2 s"]["error"] > rows["convolution 10 s"]["error"]
+    assert rows["convolution 10 s"]["states"] < full["states"]
+    # state-space force error follows the kernel fit tolerance (same order of magnitude)
+    assert rows["state_space tol 0.005"]["error"] < rows["state_space tol 0.05"]["error"] < 0.1
+    assert rows["state_space tol 0.005"]["error"] < 0.02
+
+
+def test_error_is_worst_component_nrms():
+    ref = np.array([[1.0, 0.0, 2.0], [-1.0, 0.0, -2.0]])
+    got = ref + [[0.1, 5.0, 0.0], [0.1, 5.0, 0.0]]
+    assert memory_cost.error(got, ref) == pytest.approx(0.1)   # zero column skipped
+
+
+def test_pareto_front():
+    rows = pareto([{"wall_s": 1, "error": 0.1}, {"wall_s": 2, "error": 0.01}, {"wall_s": 3, "error": 0.05},
+                   {"wall_s": 0.5, "error": 0.2}])
+    assert [r["pareto"] for r in rows] == [True, True, False, True]
+
+
+def test_per_call_interleaves_and_restarts():
+    calls = []
+    res = per_call({"a": lambda: (lambda k: calls.append(("a", k))),
+                    "b": lambda: (lambda k: calls.append(("b", k)))}, calls=2, rounds=2)
+    assert calls == [("a", 0), ("a", 1), ("b", 0), ("b", 1)] * 2
+    assert set(res) == {"a", "b"} and all(v >= 0 for v in res.values())
