@@ -345,7 +345,7 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
     if not isinstance(items, list):
         problems.add("couplings", "expected an array of tables ([[couplings]])")
         return []
-    out, names = [], set()
+    out, names, read = [], set(), {}
     for i, table in enumerate(items):
         where = f"couplings[{i}]"
         if not isinstance(table, dict):
@@ -371,7 +371,10 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
         if path is None or name is None or method is None:
             continue
         try:
-            decks = read_couplings(path, bodies=known)
+            key = (str(path), frozenset(known))   # a deck holds many couplings: read it once
+            if key not in read:
+                read[key] = read_couplings(path, bodies=known)
+            decks = read[key]
         except InputError as exc:
             problems.add(f"{where}.deck", str(exc))
             continue

@@ -35,12 +35,13 @@ def damping_kernel(t, b, omega_p, distance=0.0, g=G):
     return 2.0 / np.pi * out
 
 
-def coupling_kernels(timdel, lags, distance=35.0, seed=1):
+def coupling_kernels(timdel, lags, distance=35.0, seed=1, stretch=1.0):
     """A full 6×6 interaction kernel matrix {(i, j): samples} (0-based), ``lags`` samples at
     ``timdel`` [s]: every element a damping_kernel with its own peak and scale (dofs of a
-    barge pair: translations ~1e5 N·s/m, rotations ~1e9 N·m·s)."""
+    barge pair: translations ~1e5 N·s/m, rotations ~1e9 N·m·s).  ``stretch`` scales time
+    (h(t/stretch)): the same family decaying over a longer or shorter window."""
     rng = np.random.default_rng(seed)
-    t = timdel * np.arange(lags)
+    t = timdel * np.arange(lags) / stretch
     scale = np.array([1e5, 1e5, 3e5, 3e7, 3e8, 3e8])
     out = {}
     for i in range(6):

@@ -36,14 +36,15 @@ def _timed(evaluators, dt, v, calls, rounds):
 
 
 def tradeoff(lags=2000, timdel=0.05, duration=300.0, lengths=(5.0, 10.0, 20.0, 40.0),
-             tolerances=(0.1, 0.03, 0.01, 0.003), orders=(2, 4), calls=400, rounds=5):
-    """Rows {evaluator, knob, states, cost_us, cheaper, error} for the full convolution,
+             tolerances=(0.1, 0.03, 0.01, 0.003), orders=(2, 4), calls=400, rounds=5, dt=None):
+    """Rows {evaluator, knob, states, cost_us, cheaper, error, dt} for the full convolution,
     truncated convolutions (memory_length [s]) and state-space fits (tolerance, or a fixed
-    ERA order per element); ``cheaper`` = cost of the full convolution / cost."""
+    ERA order per element); ``cheaper`` = cost of the full convolution / cost.
+    dt [s]: the communication step (default TIMDEL)."""
     kernels = coupling_kernels(timdel, lags)
-    t = timdel * np.arange(int(round(duration / timdel)) + 1)
+    dt = timdel if dt is None else dt
+    t = dt * np.arange(int(round(duration / dt)) + 1)
     v = irregular_velocity(t)
-    dt = timdel
     cands = {"convolution full": Convolution(kernels, timdel, shape=(6, 6), v0=v[0])}
     knob = {"convolution full": f"{(lags - 1) * timdel:g} s"}
     for length in lengths:
@@ -63,16 +64,17 @@ def tradeoff(lags=2000, timdel=0.05, duration=300.0, lengths=(5.0, 10.0, 20.0, 4
     cost = _timed(cands, dt, v, calls, rounds)
     return [{"evaluator": name, "knob": knob[name], "states": getattr(ev, "order", 0) or ev.nodes,
              "cost_us": 1e6 * cost[name], "cheaper": cost["convolution full"] / cost[name],
-             "error": error(forces[name], ref)}
+             "error": error(forces[name], ref), "dt": dt}
             for name, ev in cands.items()]
 
 
 def growth(lag_counts=(100, 300, 1000, 3000, 10000), timdel=0.05, tol=0.01, calls=300, rounds=5):
     """Rows {lags, memory_s, convolution_us, state_space_us, states}: cost per step of
-    each evaluator as the kernel grows (same 6×6 kernel family, longer windows)."""
+    each evaluator as the kernel grows (the 6×6 kernel family stretched in time so that it
+    decays within the window as the 2000-lag one does: the same shape, more samples)."""
     rows = []
     for lags in lag_counts:
-        kernels = coupling_kernels(timdel, lags)
+        kernels = coupling_kernels(timdel, lags, stretch=lags / 2000)
         v = irregular_velocity(timdel * np.arange(lags + calls + 1))
         cands = {"convolution": Convolution(kernels, timdel, shape=(6, 6)),
                  "state_space": StateSpace(kernels, timdel, shape=(6, 6), tol=tol)}

@@ -171,8 +171,11 @@ def _blocks(cur, data, head):
                                              f"(continue a long line with '&')")
         if len(words) > n:
             raise _at(vl, n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
-        data.kernels[dofs] = np.array([convert(_at(vl, k), f"RETij({k + 1})", w, float)
-                                       for k, w in enumerate(words)])
+        try:
+            data.kernels[dofs] = np.array([float(w.replace("D", "E").replace("d", "e")) for w in words])
+        except ValueError:   # find the bad value and its physical line only now (_at reads the file)
+            for k, w in enumerate(words):
+                convert(_at(vl, k), f"RETij({k + 1})", w, float)
     if not first:
         where = cur.peek() or head
         raise where.error("NRETij", f"expected at least one 'NRETij IDOF_A IDOF_B' block after {ELEMENTS!r}")
