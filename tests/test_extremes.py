@@ -831,6 +831,14 @@ def _check_recovered(kind, fmu, data, accepted):
               rtol=1e-9)
 
 
+def _three_good_steps(kind, fmu):
+    """Steps at t = 0, 0.1, 0.2 with good inputs, then the inputs of t = 0.3."""
+    for k in range(3):
+        _good_inputs(kind, fmu, k)
+        assert do_step(fmu, 0.1 * k, 0.1) == 0
+    _good_inputs(kind, fmu, 3)
+
+
 @pytest.mark.parametrize("kind, name, bad", BAD, ids=[f"{k}-{n}-{b}" for k, n, b in BAD])
 def test_nan_inf_input_is_error_then_recovers(ext, kind, name, bad):
     """A non-finite input: fmi2DoStep returns fmi2Error, an error log line names the variable,
@@ -840,10 +848,7 @@ def test_nan_inf_input_is_error_then_recovers(ext, kind, name, bad):
     messages = []
     fmu = open_fmu(folder, kind, messages)
     try:
-        for k in range(3):
-            _good_inputs(kind, fmu, k)
-            assert do_step(fmu, 0.1 * k, 0.1) == 0
-        _good_inputs(kind, fmu, 3)
+        _three_good_steps(kind, fmu)
         good = fmu.slave.getReal([fmu.vr[name]])
         fmu.slave.setReal([fmu.vr[name]], [bad])
         assert do_step(fmu, 0.3, 0.1) == 3
@@ -863,10 +868,7 @@ def test_bad_step_is_error_then_recovers(ext, kind, step):
     messages = []
     fmu = open_fmu(folder, kind, messages)
     try:
-        for k in range(3):
-            _good_inputs(kind, fmu, k)
-            assert do_step(fmu, 0.1 * k, 0.1) == 0
-        _good_inputs(kind, fmu, 3)
+        _three_good_steps(kind, fmu)
         assert do_step(fmu, 0.3, step) == 3
         assert any(st == 3 and "communication step" in m for st, m in messages), messages
         assert do_step(fmu, 0.3, 0.1) == 0

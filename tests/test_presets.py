@@ -3,7 +3,6 @@ the knobs it sets itself win; a run reports the preset and every knob; and the p
 order as promised against the monolithic two-body solution."""
 import json
 
-import numpy as np
 import pytest
 
 from hydrofmu.bench.fleet import Fleet, nrms
@@ -73,4 +72,5 @@ def test_presets_trade_speed_for_accuracy(tmp_path):
         ref = fleet.monolithic(result.time)
         errors[name] = nrms(fleet.displacements(result)[:, MOVING], ref[:, MOVING]).max()
     assert errors["screening"] > errors["design"] > errors["reference"]
-    assert errors["screening"] < 0.03 and errors["design"] < 0.01 and errors["reference"] < 0.002, errors
+    # measured: 1.3 %, 0.086 %, 0.064 % (reference: the floor of the kernels sampled at TIMDEL)
+    assert errors["screening"] < 0.03 and errors["design"] < 0.003 and errors["reference"] < 0.0015, errors
