@@ -339,6 +339,16 @@ class Coupling:
     memory_length: object = None
     set: list = field(default_factory=list)   # memory knobs the scene sets itself
 
+    def model(self, v0_a=None, v0_b=None):
+        """The physics.coupling.Coupling of this coupling, with its own evaluator settings
+        (v0_a, v0_b: the bodies' velocities at the start)."""
+        from types import SimpleNamespace
+        from .physics.coupling import Coupling as Model
+        data = SimpleNamespace(name=self.name, body_a=self.a, body_b=self.b, added_mass=self.data["added_mass"],
+                               timdel=self.data["timdel"],
+                               kernels={(i, j): np.asarray(h, float) for i, j, h in self.data["kernels"]})
+        return Model(data, self.method, self.tolerance, self.order, self.memory_length, v0_a=v0_a, v0_b=v0_b)
+
 
 def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
     from .decks.simo import read_couplings

@@ -8,12 +8,10 @@ evaluation) and steps (doStep: commits the memory); in-process, the same kernel 
 compute the same loads from the same inputs.  overhead = FMU time / in-process time.
 """
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
 from ..decks.simo import format_coupling, write_couplings
-from ..physics.coupling import Coupling
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.state import Env, Motion
 from .kernels import coupling_kernels, irregular_velocity
@@ -131,9 +129,7 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
         loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects])
         memories = []
         for c in scene.couplings:
-            data = SimpleNamespace(name=c.name, body_a=c.a, body_b=c.b, added_mass=c.data["added_mass"],
-                                   timdel=c.data["timdel"], kernels={(i, j): np.asarray(h) for i, j, h in c.data["kernels"]})
-            model = Coupling(data, c.method, c.tolerance, c.order, c.memory_length, v0_a=va[0], v0_b=vb[0])
+            model = c.model(v0_a=va[0], v0_b=vb[0])
             memories.append((model.memory["A"], va if c.b == "a" else vb))
 
         def step(k):

@@ -337,14 +337,10 @@ def osp_system_structure(scene, specs, conns):
 
 def report_fits(scene, log):
     """State-space couplings: fitted order and error of every kernel, at build time."""
-    from types import SimpleNamespace
-    from ..physics.coupling import Coupling
     for c in scene.couplings:
         if c.method != "state_space" or not c.data["kernels"]:
             continue
-        data = SimpleNamespace(name=c.name, body_a=c.a, body_b=c.b, added_mass=c.data["added_mass"],
-                               timdel=c.data["timdel"], kernels={(i, j): h for i, j, h in c.data["kernels"]})
-        model = Coupling(data, "state_space", c.tolerance, c.order, c.memory_length)
+        model = c.model()
         worst = max(f.error for f in model.fits.values())
         log(f"coupling {c.name}: state-space orders "
             + ", ".join(f"{i}{j}:{f.order}" for (i, j), f in sorted(model.fits.items()))
