@@ -7,7 +7,9 @@ through fmpy and libcosimpy.
 """
 
 import math
+import os
 import shutil
+import sys
 import uuid
 import zipfile
 from ctypes import byref, c_double, c_void_p
@@ -147,9 +149,13 @@ def test_layout(fmus):
     lib = f"binaries/linux64/{mid}.so"
     with zipfile.ZipFile(plain) as zp, zipfile.ZipFile(shimmed) as zs:
         orig, names = zp.read(lib), set(zs.namelist())
-        assert names == set(zp.namelist()) | {f"binaries/linux64/{mid}_pythonfmu.so"}
+        assert names == set(zp.namelist()) | {f"binaries/linux64/{mid}_pythonfmu.so", shim.RECORD}
         assert zs.read(f"binaries/linux64/{mid}_pythonfmu.so") == orig
         assert zs.read(lib) == shim._cached_shim().read_bytes()
+        # the interpreter a process without Python starts: this one, with a libpython that exists
+        record = dict(line.split("=", 1) for line in zs.read(shim.RECORD).decode().splitlines())
+        assert record["executable"] == sys.executable and os.path.isfile(record["libpython"])
+        assert record["version"] == "%d.%d" % sys.version_info[:2]
         # every other entry (resources, win64 dll, XML) is byte-identical
         for n in zp.namelist():
             if n != lib:

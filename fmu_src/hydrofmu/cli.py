@@ -33,7 +33,6 @@ def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim; write CSV/PNG."""
     if engine == "libcosim":
         from .cosim.libcosim import run
-        kw.pop("algorithm", None)
     else:
         from .cosim.master import run
     result = run(folder, **kw)

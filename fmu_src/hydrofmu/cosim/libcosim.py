@@ -1,22 +1,25 @@
 """Run a built scene in libcosim (the Open Simulation Platform's engine) via libcosimpy.
 
 libcosim's fixed-step algorithm is a Jacobi scheme: all slaves step, then outputs are
-copied to inputs.  So its results equal hydrofmu's fmpy master in ``jacobi`` mode.
-libcosim counts time in integer nanoseconds.
+copied to inputs.  So its results equal hydrofmu's fmpy master in ``jacobi`` mode, and a
+run asked to be Gauss–Seidel (by the scene or the caller) is refused rather than quietly
+run as Jacobi.  libcosim counts time in integer nanoseconds.
 """
 import json
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from .master import Result, run_settings
 
 NS = 1_000_000_000
 
 
-def run(folder, stop=None, step=None, record=None):
+def run(folder, stop=None, step=None, record=None, algorithm=None):
     """Run the scene built in ``folder`` (its manifest.json) in libcosim; returns a Result
-    with the same columns as cosim.master.run (default: every output of every FMU)."""
+    with the same columns as cosim.master.run (default: every output of every FMU).
+    ``algorithm`` (default: the scene's) must be 'jacobi': InputError otherwise."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -26,6 +29,12 @@ def run(folder, stop=None, step=None, record=None):
     log_output_level(CosimLogLevel.WARNING)
     folder = Path(folder)
     manifest = json.loads((folder / "manifest.json").read_text())
+    wanted = algorithm or manifest["run"]["algorithm"]
+    if wanted != "jacobi":
+        where = "--algorithm" if algorithm else folder / "manifest.json"
+        raise InputError(where, None, "algorithm", f"libcosim's fixed-step master is a Jacobi scheme and cannot "
+                         f"run '{wanted}' (the scene's or the run's choice); run with the fmpy engine, "
+                         "or ask for Jacobi explicitly (--algorithm jacobi, algorithm='jacobi')")
     stop = manifest["run"]["stop"] if stop is None else stop
     step = manifest["run"]["step"] if step is None else step
     step_ns = int(round(step * NS))

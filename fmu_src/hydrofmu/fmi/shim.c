@@ -21,10 +21,26 @@
  * callback struct whose componentEnvironment is that Shim, so messages route to
  * the right host even while the inner fmi2Instantiate is still running.
  * pythonfmu hands over message text, not a format: '%' is doubled on the way.
+ *
+ * Python in a native host: pythonfmu's binary needs libpython's symbols but is not
+ * linked against it, so in a process without Python it cannot even be loaded.  Before
+ * loading it the shim checks for Python (Py_IsInitialized visible in the process and
+ * true); if there is none it loads the libpython of the interpreter named in
+ * resources/hydrofmu_python.txt (written at build time: the build's interpreter) or
+ * in $HYDROFMU_PYTHON (asked for its libpython), with RTLD_GLOBAL so that extension
+ * modules (numpy) find it too, initialises it with that interpreter as program name
+ * (so its prefix, venv and site-packages are those of a plain run of it), checks that
+ * numpy imports, and releases the GIL.  The interpreter then lives until the process
+ * ends: numpy cannot be imported again after Py_Finalize.  pythonfmu then finds Python
+ * initialised and leaves it alone.  Every forwarded call holds the GIL (pythonfmu
+ * takes it too; PyGILState calls nest), so hosts may call from any thread.
+ * A failure is kept and reported by fmi2Instantiate as one log message.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -122,8 +138,15 @@ static struct {
 
 static void *inner_handle;
 static int inner_ok;
-static char inner_err[8192]; /* room for a full path plus dlerror() text */
+static char inner_err[16384]; /* room for a few full paths plus dlerror() text */
 static pthread_once_t inner_once = PTHREAD_ONCE_INIT;
+
+/* The GIL functions of the process's Python (PyGILState_STATE is an int-sized enum). */
+static int (*gil_ensure)(void);
+static void (*gil_release)(int);
+
+#define GIL_TAKE int gil_ = gil_ensure ? gil_ensure() : 0
+#define GIL_GIVE if (gil_ensure) gil_release(gil_)
 
 /* Path of the inner library: this file's path with ".so" replaced by "_pythonfmu.so". */
 static int inner_path(char *out, size_t size) {
@@ -143,9 +166,222 @@ static int inner_path(char *out, size_t size) {
     return 1;
 }
 
+/* ---- starting Python in a process that has none ---- */
+
+#define MINIMUM_PYTHON "3.10"
+#define MINIMUM_PYTHON_TUPLE "3, 10"
+#define HOWTO "Set HYDROFMU_PYTHON to a Python >= " MINIMUM_PYTHON " interpreter (or venv python) " \
+    "that has numpy and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
+
+/* Run in the new interpreter: sys._hydrofmu_check = '' when usable, else why not. */
+static const char CHECK[] =
+    "import sys\n"
+    "def _c():\n"
+    "    v = '%d.%d.%d' % sys.version_info[:3]\n"
+    "    if sys.version_info < (" MINIMUM_PYTHON_TUPLE "):\n"
+    "        return 'Python %s at %s is older than " MINIMUM_PYTHON "' % (v, sys.executable)\n"
+    "    try:\n"
+    "        import numpy\n"
+    "    except Exception as e:\n"
+    "        return 'Python %s at %s (sys.prefix %s) cannot import numpy: %s: %s' % (\n"
+    "            v, sys.executable, sys.prefix, type(e).__name__, e)\n"
+    "    return ''\n"
+    "sys._hydrofmu_check = _c()\n"
+    "del _c\n";
+
+/*
+ * What $HYDROFMU_PYTHON is asked: its libpython (the first candidate file that exists,
+ * else the bare soname for the loader's search path) and its version.  The build
+ * records the same (shim.py: python_record).
+ */
+static const char QUERY[] =
+    "import os, sys, sysconfig as s\n"
+    "d, names = s.get_config_var('LIBDIR') or '', [s.get_config_var(k) for k in ('INSTSONAME', 'LDLIBRARY')]\n"
+    "c = [os.path.join(d, n) for n in names if n and '.so' in n]\n"
+    "print(next((p for p in c if os.path.isfile(p)), names[0] or ''))\n"
+    "print('%d.%d' % sys.version_info[:2])\n";
+
+/* The interpreter to start: executable, libpython, version, and where they came from. */
+typedef struct {
+    char exe[4096], lib[4096], version[64], origin[4200];
+} Interpreter;
+
+static void chomp(char *s) {
+    size_t n = strlen(s);
+    while (n && (s[n - 1] == '\n' || s[n - 1] == '\r')) s[--n] = '\0';
+}
+
+/* Read resources/hydrofmu_python.txt (key=value lines) beside the shim's FMU folder. */
+static int recorded_interpreter(Interpreter *py, const char *self) {
+    char path[4200];
+    const char *end = self + strlen(self);
+    for (int up = 0; up < 3 && end > self; up++) /* strip /<id>.so, /linux64, /binaries */
+        while (end > self && *--end != '/') {}
+    snprintf(path, sizeof path, "%.*s/resources/hydrofmu_python.txt", (int)(end - self), self);
+    snprintf(py->origin, sizeof py->origin, "recorded at build time in %s", path);
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        snprintf(inner_err, sizeof inner_err, "there is no Python in this process and %s cannot be read. %s",
+                 path, HOWTO);
+        return 0;
+    }
+    char line[4200];
+    while (fgets(line, sizeof line, f)) {
+        chomp(line);
+        char *eq = strchr(line, '=');
+        if (!eq) continue;
+        *eq = '\0';
+        if (!strcmp(line, "executable")) snprintf(py->exe, sizeof py->exe, "%s", eq + 1);
+        if (!strcmp(line, "libpython")) snprintf(py->lib, sizeof py->lib, "%s", eq + 1);
+        if (!strcmp(line, "version")) snprintf(py->version, sizeof py->version, "%s", eq + 1);
+    }
+    fclose(f);
+    if (!py->exe[0] || !py->lib[0]) {
+        snprintf(inner_err, sizeof inner_err, "there is no Python in this process and %s names no executable "
+                 "and libpython. %s", path, HOWTO);
+        return 0;
+    }
+    return 1;
+}
+
+/* Ask the interpreter named by $HYDROFMU_PYTHON for its libpython and version. */
+static int asked_interpreter(Interpreter *py, const char *exe) {
+    snprintf(py->exe, sizeof py->exe, "%s", exe);
+    snprintf(py->origin, sizeof py->origin, "from HYDROFMU_PYTHON=%s", exe);
+    /* single-quote the path for the shell: ' becomes '\'' */
+    char cmd[8192 + sizeof QUERY * 2], *q = cmd;
+    q += sprintf(q, "'");
+    for (const char *p = exe; *p && q < cmd + 8192; p++) q += *p == '\'' ? sprintf(q, "'\\''") : sprintf(q, "%c", *p);
+    q += sprintf(q, "' -I -S -c \"");
+    for (const char *p = QUERY; *p; p++) {
+        if (*p == '"' || *p == '\\' || *p == '$' || *p == '`') *q++ = '\\';
+        *q++ = *p;
+    }
+    sprintf(q, "\" 2>&1");
+    FILE *f = popen(cmd, "r");
+    int ok = f && fgets(py->lib, sizeof py->lib, f) && fgets(py->version, sizeof py->version, f);
+    int rc = f ? pclose(f) : -1;
+    chomp(py->lib);
+    chomp(py->version);
+    if (!ok || rc != 0 || !py->lib[0]) {
+        snprintf(inner_err, sizeof inner_err,
+                 "there is no Python in this process and HYDROFMU_PYTHON=%s could not be asked for its "
+                 "libpython (%s%s). %s", exe, py->lib[0] ? "it said: " : "it did not run", py->lib, HOWTO);
+        return 0;
+    }
+    return 1;
+}
+
+/* Load, initialise and check the interpreter; on return the GIL is released. */
+static int start_python(const char *self) {
+    Interpreter py;
+    memset(&py, 0, sizeof py);
+    const char *env = getenv("HYDROFMU_PYTHON");
+    if (env && *env ? !asked_interpreter(&py, env) : !recorded_interpreter(&py, self)) return 0;
+    /* a libpython already loaded but not initialised serves as it is */
+    int loaded = dlsym(RTLD_DEFAULT, "Py_IsInitialized") != NULL;
+    void *h = loaded ? RTLD_DEFAULT : dlopen(py.lib, RTLD_NOW | RTLD_GLOBAL);
+    if (!loaded && !h) {
+        const char *e = dlerror();
+        snprintf(inner_err, sizeof inner_err,
+                 "there is no Python in this process and the libpython of Python %s at %s (%s) cannot be "
+                 "loaded: %s. %s", py.version, py.exe, py.origin, e ? e : "unknown error", HOWTO);
+        return 0;
+    }
+    struct {
+        int (*IsInitialized)(void);
+        wchar_t *(*DecodeLocale)(const char *, size_t *);
+        void (*SetProgramName)(const wchar_t *);
+        void (*InitializeEx)(int);
+        int (*RunSimpleString)(const char *);
+        void *(*SysGetObject)(const char *);
+        const char *(*AsUTF8)(void *);
+        void *(*SaveThread)(void);
+    } api;
+    const char *names[] = {"Py_IsInitialized", "Py_DecodeLocale", "Py_SetProgramName", "Py_InitializeEx",
+                           "PyRun_SimpleString", "PySys_GetObject", "PyUnicode_AsUTF8", "PyEval_SaveThread"};
+    void **slots = (void **)&api; /* all members are pointers, in the order of names */
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        if (!(slots[i] = dlsym(h, names[i]))) {
+            snprintf(inner_err, sizeof inner_err, "%s (libpython of Python %s at %s, %s) has no %s: not a "
+                     "CPython >= " MINIMUM_PYTHON "? %s", py.lib, py.version, py.exe, py.origin, names[i], HOWTO);
+            return 0;
+        }
+    }
+    if (!api.IsInitialized()) {
+        /* the program name makes Python find its prefix, venv and site-packages as when run;
+           it must stay valid while Python runs: never freed */
+        wchar_t *name = api.DecodeLocale(py.exe, NULL);
+        if (name) api.SetProgramName(name);
+        api.InitializeEx(0); /* 0: leave the host's signal handlers alone */
+    }
+    api.RunSimpleString(CHECK);
+    void *msg = api.SysGetObject("_hydrofmu_check");
+    const char *text = msg ? api.AsUTF8(msg) : NULL;
+    int ok = text && !*text;
+    if (!ok)
+        snprintf(inner_err, sizeof inner_err, "there is no Python in this process; started Python %s at %s "
+                 "(%s, libpython %s), but %s. %s", py.version, py.exe, py.origin, py.lib,
+                 text ? text : "its check did not run (not Python 3?)", HOWTO);
+    api.SaveThread(); /* release the GIL: every call takes it, from whatever thread */
+    return ok;
+}
+
+/*
+ * Python's main thread: the thread that initialises Python must outlive every use of
+ * it (when it ends, the C library frees memory the interpreter still refers to, and
+ * the process later dies at exit), and a host may instantiate from a worker thread
+ * that ends.  So a thread of the shim's own starts Python, then sleeps until the
+ * process exits, with every signal blocked (they go to the host's threads).  The shim
+ * is pinned in memory (RTLD_NODELETE) since that thread sleeps in its code.
+ */
+static struct {
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    const char *self;
+    int done, ok;
+} starter = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, NULL, 0, 0};
+
+static void *python_main(void *arg) {
+    (void)arg;
+    sigset_t all;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, NULL);
+    int ok = start_python(starter.self);
+    pthread_mutex_lock(&starter.lock);
+    starter.ok = ok;
+    starter.done = 1;
+    pthread_cond_signal(&starter.cond);
+    pthread_mutex_unlock(&starter.lock);
+    for (;;) pause();
+    return NULL;
+}
+
+static int python_in_own_thread(const char *self) {
+    Dl_info info;
+    if (dladdr(&starter, &info) && info.dli_fname) dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    starter.self = self;
+    pthread_t t;
+    if (pthread_create(&t, NULL, python_main, NULL) != 0) {
+        snprintf(inner_err, sizeof inner_err, "cannot create a thread to start Python in");
+        return 0;
+    }
+    pthread_detach(t);
+    pthread_mutex_lock(&starter.lock);
+    while (!starter.done) pthread_cond_wait(&starter.cond, &starter.lock);
+    pthread_mutex_unlock(&starter.lock);
+    return starter.ok;
+}
+
 static void load_inner(void) {
     char path[4096];
     if (!inner_path(path, sizeof path)) return;
+    int (*initialized)(void);
+    *(void **)&initialized = dlsym(RTLD_DEFAULT, "Py_IsInitialized");
+    if (!(initialized && initialized()) && !python_in_own_thread(path)) return;
+    *(void **)&gil_ensure = dlsym(RTLD_DEFAULT, "PyGILState_Ensure");
+    *(void **)&gil_release = dlsym(RTLD_DEFAULT, "PyGILState_Release");
+    if (!gil_release) gil_ensure = NULL;
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!h) {
         const char *e = dlerror();
@@ -222,8 +458,14 @@ static int wanted(const Shim *s, fmi2Status st, fmi2String cat) {
  */
 static void shim_logger(fmi2ComponentEnvironment e, fmi2String name, fmi2Status st,
                         fmi2String cat, fmi2String msg, ...) {
+    static const char *by_status[] = {"logStatusOK", "logStatusWarning", "logStatusDiscard",
+                                      "logStatusError", "logStatusFatal", "logStatusPending"};
     const Shim *s = e;
-    if (!s || !s->logger || !msg || !wanted(s, st, cat)) return;
+    /* never hand the host a NULL string (pythonfmu reports exceptions with no category) */
+    if (!cat) cat = st >= fmi2OK && st <= fmi2Pending ? by_status[st] : "";
+    if (!name) name = "";
+    if (!msg) msg = "(no message)";
+    if (!s || !s->logger || !wanted(s, st, cat)) return;
     size_t n = strlen(msg), k = 0;
     for (const char *p = strchr(msg, '%'); p; p = strchr(p + 1, '%')) k++;
     if (k == 0) {
@@ -256,18 +498,22 @@ static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
     EXPORT fmi2Status fmi2##name params {                 \
         if (!ready() || !c) return fmi2Error;             \
         c = ((Shim *)c)->inner;                           \
-        return inner.name args;                           \
+        GIL_TAKE;                                         \
+        fmi2Status st_ = inner.name args;                 \
+        GIL_GIVE;                                         \
+        return st_;                                       \
     }
 FMI_STATUS_FUNCS(FORWARD)
 #undef FORWARD
 
 /* ---- the rest ---- */
+/* Constants of the standard: answered without loading Python or the inner library. */
 EXPORT const char *fmi2GetTypesPlatform(void) {
-    return ready() ? inner.GetTypesPlatform() : "default";
+    return "default";
 }
 
 EXPORT const char *fmi2GetVersion(void) {
-    return ready() ? inner.GetVersion() : "2.0";
+    return "2.0";
 }
 
 EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
@@ -302,7 +548,9 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
                                   s};
     memcpy(&s->cb, &mine, sizeof mine);
     /* inner logging always on: the filtering is done in shim_logger */
+    GIL_TAKE;
     s->inner = inner.Instantiate(name, type, guid, res, &s->cb, visible, 1);
+    GIL_GIVE;
     if (!s->inner) {
         s->release(s);
         return NULL;
@@ -313,7 +561,11 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
 EXPORT void fmi2FreeInstance(fmi2Component c) {
     Shim *s = c;
     if (!s) return;
-    if (ready()) inner.FreeInstance(s->inner); /* may still log: s stays valid until after */
+    if (ready()) { /* may still log: s stays valid until after */
+        GIL_TAKE;
+        inner.FreeInstance(s->inner);
+        GIL_GIVE;
+    }
     if (s->cats) s->release(s->cats);
     s->release(s);
 }
@@ -346,11 +598,16 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n,
     s->cats = cats;
     s->ncat = n;
     s->logging = on != 0;
-    return inner.SetDebugLogging(s->inner, 1, 0, NULL);
+    GIL_TAKE;
+    fmi2Status st = inner.SetDebugLogging(s->inner, 1, 0, NULL);
+    GIL_GIVE;
+    return st;
 }
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior) {
     if (!ready() || !c) return fmi2Error;
+    GIL_TAKE;
     fmi2Status s = inner.DoStep(((Shim *)c)->inner, t, h, noPrior);
+    GIL_GIVE;
     return s == fmi2Discard ? fmi2Error : s;
 }

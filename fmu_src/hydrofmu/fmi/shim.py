@@ -6,10 +6,14 @@ shim turns that ``fmi2DoStep`` status into ``fmi2Error``.  pythonfmu also drops 
 log message while the host's logging is off; the shim keeps the inner FMU's logging
 on and passes warnings and errors to the host always, other messages only when the
 host's logging is on for their category.  Everything else is forwarded unchanged.
-Layout inside the FMU after ``install_shim``::
+In a host process without Python (a native FMI host such as libcosim's ``cosim``) the
+shim starts the interpreter recorded at build time (``$HYDROFMU_PYTHON`` overrides it)
+before loading pythonfmu's binary; see shim.c.  Layout inside the FMU after
+``install_shim``::
 
-    binaries/linux64/<id>.so            the shim (compiled from shim.c)
-    binaries/linux64/<id>_pythonfmu.so  pythonfmu's original binary, loaded by the shim
+    binaries/linux64/<id>.so              the shim (compiled from shim.c)
+    binaries/linux64/<id>_pythonfmu.so    pythonfmu's original binary, loaded by the shim
+    resources/hydrofmu_python.txt         the interpreter to start where there is no Python
 
 Linux only: other platforms' binaries are left untouched (they keep pythonfmu's
 Discard mapping).
@@ -23,6 +27,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import time
 import zipfile
@@ -34,6 +39,8 @@ FLAGS = ["-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=c99"]
 LIBS = ["-ldl", "-lpthread"]  # after the source: link order matters with --as-needed
 INNER_SUFFIX = "_pythonfmu.so"
 PLATFORM_DIR = "binaries/linux64"
+RECORD = "resources/hydrofmu_python.txt"
+ENV = "HYDROFMU_PYTHON"  # names another interpreter for the FMUs (read by shim.c)
 
 
 def _compiler() -> list[str]:
@@ -100,6 +107,19 @@ def compile_shim(out_path) -> Path:
     return out
 
 
+def python_record() -> str:
+    """resources/hydrofmu_python.txt: this interpreter (``sys.executable``, not resolved,
+    so that a venv stays a venv), its libpython and version.  The libpython is the first
+    of LIBDIR/INSTSONAME, LIBDIR/LDLIBRARY that exists, else the bare soname (found by the
+    loader's search path); shim.c asks a $HYDROFMU_PYTHON interpreter the same way."""
+    libdir = sysconfig.get_config_var("LIBDIR") or ""
+    names = [sysconfig.get_config_var(k) for k in ("INSTSONAME", "LDLIBRARY")]
+    candidates = [os.path.join(libdir, n) for n in names if n and ".so" in n]
+    lib = next((p for p in candidates if os.path.isfile(p)), names[0] or "")
+    version = "%d.%d" % sys.version_info[:2]
+    return f"executable={sys.executable}\nlibpython={lib}\nversion={version}\n"
+
+
 def _model_identifier(zin: zipfile.ZipFile, fmu: Path) -> str:
     """CoSimulation/@modelIdentifier from the FMU's modelDescription.xml."""
     try:
@@ -130,9 +150,9 @@ def _entry(name: str, like: zipfile.ZipInfo | None = None) -> zipfile.ZipInfo:
 def install_shim(fmu_path) -> Path:
     """Put the shim into the FMU at ``fmu_path`` (rewritten in place) and return the path.
 
-    ``binaries/linux64/<id>.so`` moves to ``binaries/linux64/<id>_pythonfmu.so`` and the
-    shim takes its place; every other entry is copied unchanged.  Running it again on a
-    shimmed FMU only refreshes the shim.  The new zip is written to a temporary file
+    ``binaries/linux64/<id>.so`` moves to ``binaries/linux64/<id>_pythonfmu.so``, the
+    shim takes its place and RECORD names this interpreter; every other entry is copied
+    unchanged.  Running it again on a shimmed FMU only refreshes the shim and RECORD.  The new zip is written to a temporary file
     beside the FMU and swapped in at the end, so a failure leaves the FMU as it was.
     """
     fmu = Path(fmu_path)
@@ -153,8 +173,11 @@ def install_shim(fmu_path) -> Path:
                     if not shimmed:
                         zout.writestr(_entry(inner, info), zin.read(info))
                     zout.writestr(_entry(outer), shim)
-                else:
+                elif info.filename != RECORD:
                     zout.writestr(_entry(info.filename, info), zin.read(info))
+            record = _entry(RECORD)
+            record.external_attr = (0o100644 & 0xFFFF) << 16
+            zout.writestr(record, python_record())
         shutil.copymode(fmu, tmp)
         os.replace(tmp, fmu)
     finally:
