@@ -14,6 +14,7 @@ Initialisation resolves the feedthrough: connections are transferred twice insid
 initialization mode, so at t = 0 every load output reflects the initial motion.
 """
 import csv
+import ctypes
 import sys
 import time as clock
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ import json
 
 import numpy as np
 from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
@@ -105,6 +107,16 @@ class Instance:
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+        # outputs that depend on inputs (no dependency list: assume they all do)
+        self.feedthrough = any(u.dependencies is None or u.dependencies for u in self.md.outputs)
+        # the stepping loop calls the C functions itself: fmpy's wrappers build the value
+        # reference array and the result list anew at every call
+        dll = self.fmu.dll
+        self._get, self._set, self._step = dll["fmi2GetReal"], dll["fmi2SetReal"], dll["fmi2DoStep"]
+        self._get.argtypes = self._set.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_uint),
+                                                   ctypes.c_size_t, ctypes.POINTER(ctypes.c_double)]
+        self._step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+        self._get.restype = self._set.restype = self._step.restype = ctypes.c_int
 
     @staticmethod
     def _log(env, instance, status, category, message):
@@ -115,11 +127,110 @@ class Instance:
     def outputs(self):
         return [n for n, c in self.causality.items() if c == "output"]
 
+    def port(self, vrs):
+        """A preallocated block of Reals (``values``, a numpy view) for ``read``/``write``."""
+        return Port(vrs)
+
+    def _check(self, status, function):
+        if status > 1:  # above fmi2Warning
+            raise FMICallException(function=function, status=status)
+
+    def read(self, port):
+        """fmi2GetReal of the port's variables into ``port.values``."""
+        self._check(self._get(self.fmu.component, port.vr, port.n, port.buffer), "fmi2GetReal")
+
+    def write(self, port):
+        """fmi2SetReal of ``port.values``."""
+        self._check(self._set(self.fmu.component, port.vr, port.n, port.buffer), "fmi2SetReal")
+
+    def do_step(self, t, h):
+        self._check(self._step(self.fmu.component, t, h, 1), "fmi2DoStep")
+
     def free(self):
         try:
             self.fmu.terminate()
         finally:
             self.fmu.freeInstance()
+
+
+class Port:
+    """Value references and a C buffer of Reals with a numpy view (``values``) on it."""
+
+    def __init__(self, vrs):
+        self.n = len(vrs)
+        self.vr = (ctypes.c_uint * self.n)(*[int(v) for v in vrs])
+        self.buffer = (ctypes.c_double * self.n)()
+        self.values = np.ctypeslib.as_array(self.buffer) if self.n else np.zeros(0)
+
+
+class Exchange:
+    """The per-step traffic of a run, batched: one fmi2GetReal per FMU of every output that
+    is connected or recorded, one fmi2SetReal per FMU of all its connected inputs."""
+
+    def __init__(self, system, record):
+        inst = system.instances
+        reads = {name: set() for name in inst}
+        for src, _, svr, _ in system.links:
+            reads[src].update(svr.tolist())
+        columns = {}
+        for j, col in enumerate(record):
+            name, var = col.split(".", 1)
+            reads[name].add(inst[name].vr[var])
+            columns.setdefault(name, ([], []))[0].append(j)
+            columns[name][1].append(inst[name].vr[var])
+        self.read = {name: inst[name].port(sorted(v)) for name, v in reads.items() if v}
+        where = {name: {vr: k for k, vr in enumerate(port.vr)} for name, port in self.read.items()}
+        self.record = [(self.read[name].values, np.array(cols), np.array([where[name][v] for v in vrs]))
+                       for name, (cols, vrs) in columns.items()]
+        self.write, self.gather, self.sources = {}, {}, {}
+        for dst in inst:
+            links = [(s, svr, dvr) for s, d, svr, dvr in system.links if d == dst]
+            if not links:
+                continue
+            port = self.write[dst] = inst[dst].port([v for _, _, dvr in links for v in dvr.tolist()])
+            at, self.gather[dst] = 0, []
+            for s, svr, dvr in links:
+                idx = np.array([where[s][v] for v in svr.tolist()])
+                self.gather[dst].append((self.read[s].values, idx, slice(at, at + len(dvr))))
+                at += len(dvr)
+            self.sources[dst] = {s for s, _, _ in links}
+        self.instances = inst
+
+    def read_all(self, names=None):
+        for name, port in self.read.items():
+            if names is None or name in names:
+                self.instances[name].read(port)
+
+    def set_inputs(self, name):
+        port = self.write[name]
+        for values, idx, at in self.gather[name]:
+            port.values[at] = values[idx]
+        self.instances[name].write(port)
+
+    def resolve(self, order):
+        """Gauss–Seidel: set each FMU's inputs in ``order`` from the latest outputs (read
+        when first needed, and again when the FMU's own inputs changed them)."""
+        fresh = set()
+        for inst in order:
+            name = inst.name
+            if name in self.write:
+                stale = self.sources[name] - fresh
+                self.read_all(stale)
+                fresh |= stale
+                self.set_inputs(name)
+                if inst.feedthrough:
+                    fresh.discard(name)
+        self.read_all(set(self.read) - fresh)
+
+    def jacobi(self):
+        """Read every output, then set every input (libcosim's fixed-step exchange)."""
+        self.read_all()
+        for name in self.write:
+            self.set_inputs(name)
+
+    def sample(self, row):
+        for values, cols, idx in self.record:
+            row[cols] = values[idx]
 
 
 class System:
@@ -200,13 +311,6 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         n = int(round(stop / step))
         if record is None:
             record = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.outputs()]
-        by_inst = {}
-        for j, col in enumerate(record):
-            name, var = col.split(".", 1)
-            by_inst.setdefault(name, ([], []))
-            by_inst[name][0].append(j)
-            by_inst[name][1].append(system.instances[name].vr[var])
-        reads = [(system.instances[k].fmu, np.array(cols), np.array(vrs)) for k, (cols, vrs) in by_inst.items()]
         values = np.empty((n + 1, len(record)))
         progress = n > 2000 if progress is None else progress
         if progress:
@@ -215,28 +319,24 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         tty = sys.stderr.isatty()
         every = max(1, n // (20 if tty else 4))  # a live line on a terminal, four lines in a log
 
-        def sample(k):
-            for fmu, cols, vrs in reads:
-                values[k, cols] = fmu.getReal(vrs)
-
+        exchange = Exchange(system, record)
         system.initialize()
-        if algorithm != "jacobi":
-            system.resolve([system.instances[name] for name in system.order])
-        sample(0)
-        t0 = clock.perf_counter()
         order = [system.instances[name] for name in system.order]
+        if algorithm != "jacobi":
+            system.resolve(order)
+        exchange.read_all()
+        exchange.sample(values[0])
+        t0 = clock.perf_counter()
         for k in range(n):
             t = k * step
+            for inst in order:
+                inst.do_step(t, step)
             if algorithm == "jacobi":
-                for inst in order:
-                    inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
-                sample(k + 1)  # before the exchange, as libcosim's observers see it
-                system.transfer()
+                exchange.jacobi()  # sampled before the exchange, as libcosim's observers see it
+                exchange.sample(values[k + 1])
             else:
-                for inst in order:
-                    inst.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
-                system.resolve(order)
-                sample(k + 1)
+                exchange.resolve(order)
+                exchange.sample(values[k + 1])
             if on_step is not None:
                 on_step(k + 1)
             if progress and (k + 1) % every == 0:

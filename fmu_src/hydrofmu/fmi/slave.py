@@ -11,6 +11,7 @@ Bad input values never raise into the host: the slave logs an error and fmi2DoSt
 returns False, which hydrofmu's binary shim reports as fmi2Error.
 """
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,7 @@ class ArraySlave(Fmi2Slave):
         self.units = {}         # variable name -> unit
         self.dependencies = {}  # output name -> input names
         self.error = None       # message of a bad input seen since the last step
+        self._finite_idx = {}   # check_finite: input slices -> their value indices
 
     # -- registration ------------------------------------------------------------------
     def add(self, name, causality, unit=None, start=0.0, description=None):
@@ -151,6 +153,12 @@ class ArraySlave(Fmi2Slave):
 
     def check_finite(self, slices):
         """Record an error naming the first non-finite input; True if all are finite."""
+        key = tuple((s.start, s.stop) for s in slices)
+        idx = self._finite_idx.get(key)
+        if idx is None:
+            idx = self._finite_idx[key] = np.r_[tuple(slices)] if slices else np.zeros(0, int)
+        if math.isfinite(self.values[idx].sum()):   # one sum; the search below only on failure
+            return True
         for s in slices:
             block = self.values[s]
             if not np.all(np.isfinite(block)):

@@ -30,6 +30,7 @@ Coverage rule ("the table spans the circle"): after expansion, the widest gap be
 consecutive angles, wrap-around included, is no wider than the widest step between the
 rows the user gave, and no wider than 90°.
 """
+import bisect
 import math
 from dataclasses import dataclass
 from typing import ClassVar
@@ -37,7 +38,6 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import InputError
-from .kinematics import point_velocity, transfer
 
 SYMMETRIES = ("none", "xz", "yz", "xz+yz")
 MAX_GAP = 90.0  # [deg] widest gap allowed between table angles after expansion
@@ -178,6 +178,8 @@ class CurrentPolar:
         self._c = np.vstack([c[-1], c, c[0]])
         self._slope = np.diff(self._c, axis=0) / np.diff(self._a)[:, None]
         self._p = np.array([self.xc, self.yc, self.zc], dtype=float)
+        # the same table as plain lists: the per-step load works on floats
+        self._rows = (self._a.tolist(), self._c.tolist(), self._slope.tolist())
 
     @classmethod
     def from_deck(cls, data, symmetry, name=None):
@@ -187,21 +189,29 @@ class CurrentPolar:
 
     def coefficients(self, alpha):
         """(CXC, CYC, CMZC) at incidence ``alpha`` [deg] in [0, 360), linear with wrap-around."""
-        i = int(np.searchsorted(self._a, alpha, side="right")) - 1
-        return self._c[i] + (alpha - self._a[i]) * self._slope[i]
+        angles, coef, slope = self._rows
+        i = bisect.bisect_right(angles, alpha) - 1
+        d = alpha - angles[i]
+        return np.array([c + d * s for c, s in zip(coef[i], slope[i])])
 
     def load(self, motion, env):
         """[force N; moment N·m about the reference point], global axes."""
-        rot = motion.rot
-        r = rot @ self._p
-        vb = rot.T @ (env.current - point_velocity(motion.velocity, r))
-        v2 = vb[0] * vb[0] + vb[1] * vb[1]
-        alpha = math.degrees(math.atan2(vb[1], vb[0])) % 360.0 if v2 > 0.0 else 0.0
+        # plain floats throughout: numpy's per-call cost dominates on 3-vectors
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = motion.rot.tolist()
+        px, py, pz = self.xc, self.yc, self.zc
+        rx, ry, rz = r00 * px + r01 * py + r02 * pz, r10 * px + r11 * py + r12 * pz, r20 * px + r21 * py + r22 * pz
+        vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
+        cx, cy, cz = env.current.tolist()
+        ux, uy, uz = cx - (vx + wy * rz - wz * ry), cy - (vy + wz * rx - wx * rz), cz - (vz + wx * ry - wy * rx)
+        bx, by = r00 * ux + r10 * uy + r20 * uz, r01 * ux + r11 * uy + r21 * uz   # body axes
+        v2 = bx * bx + by * by
+        alpha = math.degrees(math.atan2(by, bx)) % 360.0 if v2 > 0.0 else 0.0
         if alpha >= 360.0:  # -tiny % 360 rounds to 360
             alpha = 0.0
-        c = self.coefficients(alpha) * (0.5 * env.rho * self.surfc * v2)
-        force = rot[:, :2] @ c[:2]
-        return transfer(force, r, rot[:, 2] * c[2])
+        c0, c1, c2 = (self.coefficients(alpha) * (0.5 * env.rho * self.surfc * v2)).tolist()
+        fx, fy, fz = r00 * c0 + r01 * c1, r10 * c0 + r11 * c1, r20 * c0 + r21 * c1
+        return np.array((fx, fy, fz, ry * fz - rz * fy + r02 * c2, rz * fx - rx * fz + r12 * c2,
+                         rx * fy - ry * fx + r22 * c2))
 
     def mass_matrix(self, motion):
         return np.zeros((6, 6))

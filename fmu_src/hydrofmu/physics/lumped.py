@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kinematics import point_mass_matrix, point_velocity, quad, transfer
+from .kinematics import cross, point_mass_matrix, point_velocity, quad, transfer
 
 E_Z = np.array([0.0, 0.0, 1.0])
 
@@ -107,4 +107,4 @@ class LumpedBody:
         """Centripetal part of the inertia load [N, N·m]: transfer(−M_p·ω×(ω×R r), R r)."""
         r = motion.rot @ self.offset
         w = motion.velocity[3:]
-        return transfer(-self.point_mass(motion) @ np.cross(w, np.cross(w, r)), r)
+        return transfer(-self.point_mass(motion) @ cross(w, cross(w, r)), r)
