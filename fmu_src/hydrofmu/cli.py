@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | validate | demo | bench`` (a thin layer over the library)."""
+"""Command line: ``hydrofmu build | run | validate | demo | bench | bem2simo`` (a thin layer over the library)."""
 import argparse
 import json
 import sys
@@ -59,6 +59,25 @@ def validate(paths):
     return problems
 
 
+def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_length=None,
+             symmetry_tolerance=None, png=None, log=print):
+    """A BEM result (Capytaine .nc, WAMIT .1) → a SIMO deck with every self and cross coupling
+    of its bodies (BODY DATA groups first); the transform's report goes to ``log``."""
+    from .bem import couplings, plot_quality, write_simo
+    from .decks.bem import read_bem
+    from .physics.radiation import SYMMETRY_TOL
+    data = read_bem(result, ulen=ulen, rho=rho)
+    made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
+                     symmetry_tolerance or SYMMETRY_TOL)
+    for line in made.report():
+        log(line)
+    write_simo(made, out)
+    log(f"wrote {out}: couplings {', '.join(c.name for c in made.couplings)}")
+    if png:
+        log(f"wrote {plot_quality(made, png)}")
+    return made
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="hydrofmu", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -84,6 +103,16 @@ def main(argv=None):
     k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "stability"),
                    help="run only this part (repeatable)")
     k.add_argument("--quick", action="store_true", help="small sizes: a smoke run, not the README figures")
+    m = sub.add_parser("bem2simo", help="SIMO coupling deck (A∞ and retardation functions) from a BEM result")
+    m.add_argument("result", type=Path, help="Capytaine dataset (.nc) or WAMIT .1 file")
+    m.add_argument("-o", "--out", required=True, type=Path, help="SIMO deck to write")
+    m.add_argument("--ulen", type=float, help="WAMIT: the length ULEN [m] of the nondimensional file")
+    m.add_argument("--rho", type=float, default=1025.0, help="WAMIT: density [kg/m3] (default 1025)")
+    m.add_argument("--dofs", nargs="+", help="dofs to keep, e.g. Surge Heave Pitch (default: all in the file)")
+    m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
+    m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")
+    m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
+    m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -104,6 +133,9 @@ def main(argv=None):
                 result = run_folder(folders[name], "fmpy", csv, png)
                 print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
                       f"wrote {csv} and {png}")
+        elif args.command == "bem2simo":
+            bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
+                     args.symmetry_tolerance, args.png)
         elif args.command == "bench":
             from .bench.run import main as bench
             bench(args.out, args.part, args.quick)

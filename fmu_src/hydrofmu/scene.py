@@ -338,6 +338,7 @@ class Coupling:
     order: object = None
     memory_length: object = None
     set: list = field(default_factory=list)   # memory knobs the scene sets itself
+    bem: object = None                        # bem.BemCouplings when made from a BEM result
 
     def model(self, v0_a=None, v0_b=None):
         """The physics.coupling.Coupling of this coupling, with its own evaluator settings
@@ -350,7 +351,20 @@ class Coupling:
         return Model(data, self.method, self.tolerance, self.order, self.memory_length, v0_a=v0_a, v0_b=v0_b)
 
 
-def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
+def _memory_knobs(problems, table, where, memory):
+    """(method, tolerance, order, memory_length, knobs the table sets) of a coupling entry."""
+    method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"), memory["method"])
+    tol = problems.number(table, "tolerance", f"{where}.tolerance", memory["tolerance"], positive=True)
+    order = table.get("order")
+    if order is not None and (not isinstance(order, int) or isinstance(order, bool) or order < 1):
+        problems.add(f"{where}.order", f"expected a positive integer, found {order!r}")
+    length = (problems.number(table, "memory_length", f"{where}.memory_length", positive=True)
+              if "memory_length" in table else memory["memory_length"])
+    return method, tol, order, length, sorted(k for k in ("method", "tolerance", "order", "memory_length")
+                                              if k in table)
+
+
+def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
     from .decks.simo import read_couplings
     if not isinstance(items, list):
         problems.add("couplings", "expected an array of tables ([[couplings]])")
@@ -361,6 +375,13 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
         if not isinstance(table, dict):
             problems.add(where, "expected a table")
             continue
+        if "bem" in table:
+            for c in _bem_couplings(problems, table, where, bodies, memory, env or {}):
+                if c.name in names:
+                    problems.add(f"{where}.name", f"coupling names must be distinct, {c.name!r} is used twice")
+                names.add(c.name)
+                out.append(c)
+            continue
         problems.known_keys(table, where, COUPLING_KEYS)
         mapping = table.get("bodies", {})
         if not isinstance(mapping, dict) or any(v not in bodies for v in mapping.values()):
@@ -370,14 +391,7 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
         known = set(mapping) | set(bodies)
         path = _deck_path(problems, table, where)
         name = problems.string(table, "coupling", f"{where}.coupling")
-        method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"),
-                                 memory["method"])
-        tol = problems.number(table, "tolerance", f"{where}.tolerance", memory["tolerance"], positive=True)
-        order = table.get("order")
-        if order is not None and (not isinstance(order, int) or isinstance(order, bool) or order < 1):
-            problems.add(f"{where}.order", f"expected a positive integer, found {order!r}")
-        length = (problems.number(table, "memory_length", f"{where}.memory_length", positive=True)
-                  if "memory_length" in table else memory["memory_length"])
+        method, tol, order, length, knobs = _memory_knobs(problems, table, where, memory)
         if path is None or name is None or method is None:
             continue
         try:
@@ -400,13 +414,86 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS):
         if not identifier(name) or name in names:
             problems.add(f"{where}.coupling", f"coupling names must be distinct identifiers, found {name!r}")
         names.add(name)
-        out.append(Coupling(name, a, b, {
-            "added_mass": np.asarray(d.added_mass, float).tolist(),
-            "timdel": d.timdel,
-            "kernels": [[i_, j_, np.asarray(h, float).tolist()] for (i_, j_), h in d.kernels.items()],
-        }, method, tol, order, length, sorted(k for k in ("method", "tolerance", "order", "memory_length")
-                                               if k in table)))
+        out.append(Coupling(name, a, b, _coupling_data(d), method, tol, order, length, knobs))
     return out
+
+
+def _coupling_data(d):
+    """A scene coupling's plain data from a ``decks.simo.CouplingData``."""
+    return {"added_mass": np.asarray(d.added_mass, float).tolist(), "timdel": d.timdel,
+            "kernels": [[i_, j_, np.asarray(h, float).tolist()] for (i_, j_), h in d.kernels.items()]}
+
+
+BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance",
+            "method", "tolerance", "order", "memory_length"}
+CENTRE_TOL = 0.01   # m: BEM rotation centres vs scene reference points
+
+
+def _bem_couplings(problems, table, where, bodies, memory, env):
+    """A `bem = "…"` entry: every self and cross coupling of the mapped BEM bodies."""
+    from . import bem
+    from .decks.bem import read_bem
+    from .physics.radiation import SYMMETRY_TOL
+    problems.known_keys(table, where, BEM_KEYS)
+    file = problems.string(table, "bem", f"{where}.bem")
+    mapping = problems.table(table, "bodies", f"{where}.bodies")
+    if mapping is not None and (not mapping or any(v not in bodies for v in mapping.values())
+                                or len(set(mapping.values())) != len(mapping)):
+        problems.add(f"{where}.bodies", "expected a table BEM body = scene body (distinct), "
+                                        f"scene bodies: {', '.join(bodies)}")
+        mapping = None
+    prefix = problems.string(table, "name", f"{where}.name", "bem")
+    dofs = table.get("dofs")
+    if dofs is not None and (not isinstance(dofs, list) or not dofs or not all(isinstance(d, str) for d in dofs)):
+        problems.add(f"{where}.dofs", f"expected a list of dof names (\"Surge\", …, \"Yaw\"), found {dofs!r}")
+        dofs = None
+    opt = {k: problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None
+           for k in ("ulen", "timdel", "kernel_length", "symmetry_tolerance")}
+    method, tol, order, length, knobs = _memory_knobs(problems, table, where, memory)
+    if file is None or mapping is None or method is None or prefix is None or not identifier(prefix):
+        if prefix is not None and not identifier(prefix):
+            problems.add(f"{where}.name", f"expected an identifier, found {prefix!r}")
+        return []
+    path = (problems.path.parent / file).resolve()
+    if not path.is_file():
+        problems.add(f"{where}.bem", f"BEM file not found: {path}")
+        return []
+    rho = env.get("rho") or 1025.0
+    try:
+        data = read_bem(path, ulen=opt["ulen"], rho=rho)
+        for name, scene_value in (("rho", rho), ("g", env.get("g") or 9.81)):
+            value = getattr(data, name)
+            if value is not None and abs(value - scene_value) > 1e-6 * scene_value:
+                raise InputError(path, None, name, f"{name} = {value:g} in the BEM result but {scene_value:g} in the "
+                                                   f"scene (environment.{name}): solve again with {name} = "
+                                                   f"{scene_value:g}, or set environment.{name} = {value:g}")
+        _check_centres(data, mapping, bodies)
+        result = bem.couplings(data, mapping, dofs, opt["timdel"], opt["kernel_length"],
+                               opt["symmetry_tolerance"] or SYMMETRY_TOL, prefix)
+    except InputError as exc:
+        problems.add(f"{where}.bem", str(exc))
+        return []
+    return [Coupling(c.name, c.body_a, c.body_b, _coupling_data(c), method, tol, order, length, knobs, bem=result)
+            for c in result.couplings]
+
+
+def _check_centres(data, mapping, bodies):
+    """BEM rotation centres = the scene bodies' reference points, up to one horizontal shift
+    (radiation coefficients do not change when the whole group moves horizontally)."""
+    known = [b for b in data.bodies if b in mapping and b in data.rotation_centers]
+    if not known:
+        return
+    ref = known[0]
+    shift = np.array(bodies[mapping[ref]].position) - np.array(data.rotation_centers[ref])
+    shift[2] = 0.0
+    for b in known:
+        want = np.array(bodies[mapping[b]].position)
+        got = np.array(data.rotation_centers[b]) + shift
+        if np.max(np.abs(got - want)) > CENTRE_TOL:
+            raise InputError(data.path, None, f"rotation_center[{b}]",
+                             f"{data.rotation_centers[b]} m does not match the reference point of scene body "
+                             f"{mapping[b]!r} at {list(want)} m (z must agree, x and y up to one common shift "
+                             f"{shift[:2].tolist()} m); the coefficients must be about the reference point")
 
 
 JOINT_KEYS = {"type", "a", "a_point", "b", "b_point", "stiffness", "damping", "rot_stiffness",
@@ -564,11 +651,12 @@ def load_scene(path):
         joint = _joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
-    couplings = _couplings(p, doc["couplings"], bodies, run_cfg["memory"]) if "couplings" in doc else []
+    rho = p.number(env, "rho", "environment.rho", 1025.0, positive=True)
+    g = p.number(env, "g", "environment.g", 9.81, positive=True)
+    couplings = (_couplings(p, doc["couplings"], bodies, run_cfg["memory"], {"rho": rho, "g": g})
+                 if "couplings" in doc else [])
     scene = Scene(
-        name=name, path=path, joints=joints, couplings=couplings,
-        rho=p.number(env, "rho", "environment.rho", 1025.0, positive=True),
-        g=p.number(env, "g", "environment.g", 9.81, positive=True),
+        name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=p.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),
         current_direction=p.number(env, "current_direction", "environment.current_direction", 0.0),
         bodies=bodies, run=run_cfg,

@@ -347,6 +347,22 @@ def report_fits(scene, log):
             + f"; worst fit error {100 * worst:.2f} % (normalised RMS)")
 
 
+def bem_results(scene):
+    """The BEM results behind the scene's couplings (each once)."""
+    return list({id(c.bem): c.bem for c in scene.couplings if c.bem is not None}.values())
+
+
+def report_bem(scene, log, folder):
+    """BEM couplings: the transform's choices, time and quality, and a PNG of the rebuilt
+    A(ω), B(ω) per result (``<folder>/<file stem>_quality.png``)."""
+    from ..bem import plot_quality
+    for result in bem_results(scene):
+        for line in result.report():
+            log(line)
+        png = plot_quality(result, Path(folder) / f"{Path(result.data.path).stem}_quality.png")
+        log(f"  wrote {png.name}")
+
+
 def build_scene(scene, outdir, shim=True, log=print):
     """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
     The folder is replaced only when the whole build succeeded."""
@@ -371,6 +387,7 @@ def build_scene(scene, outdir, shim=True, log=print):
             log(f"built {fmu.name}")
         conns = connections(specs, slaves, dyn_of)
         result = work / "fmus"
+        report_bem(scene, log, result)
         manifest = {
             "scene": scene.name, "source": str(scene.path), "run": scene.run,
             "instances": {s["instance"]: {"fmu": f"{s['model_id']}.fmu", "kind": s["kind"], "body": s["body"]}

@@ -1,0 +1,169 @@
+"""BEM radiation results → hydrodynamic couplings between bodies (the same data a SIMO deck gives).
+
+``couplings`` reads nothing: it takes a ``decks.bem.BemData``, keeps the dofs asked for, runs
+``physics.radiation.transform`` once for all bodies together and cuts the result into one
+``decks.simo.CouplingData`` per body (self) and per pair of bodies (cross): for bodies P, Q
+(P before Q in the file) AM_ij = A∞[(P, i), (Q, j)] and the kernel of block (IDOF_A = i,
+IDOF_B = j) is K[(P, i), (Q, j)], i.e. the SIMO element convention with A = P, B = Q.
+``write_simo`` writes them as a SIMO deck (BODY DATA groups first), ``plot_quality`` draws A(ω)
+and B(ω) rebuilt from (A∞, K) against the database.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .decks.bem import DOF_NAMES, BemData
+from .decks.simo import BODY, CouplingData, format_coupling, write_couplings
+from .errors import InputError
+from .physics.radiation import SYMMETRY_TOL, AsymmetryError, GridError, Radiation, transform
+
+
+@dataclass
+class BemCouplings:
+    """``couplings``' result: the couplings, the transform behind them, the dofs kept
+    [(BEM body, k)] in the transform's order and the names the bodies were given."""
+    data: BemData
+    couplings: list
+    radiation: Radiation
+    dofs: list
+    names: dict
+
+    @property
+    def labels(self):
+        return [label(self.names[b], k) for b, k in self.dofs]
+
+    def report(self):
+        """Build-time report lines: the transform's choices, then per coupling the worst rebuilt
+        A and B errors (% of each curve's peak) with their dof pair, then warnings."""
+        r = self.radiation
+        lines = [f"BEM {self.data.kind} {self.data.path}: {len(self.labels)} dofs, {r.omega.size} frequencies "
+                 f"{r.omega[0]:g}…{r.omega[-1]:g} rad/s, transform {r.seconds:.2f} s"]
+        lines += [f"  {n}" for n in r.notes]
+        if r.asymmetry:
+            lines.append(f"  A∞ symmetrised (largest asymmetry {100 * r.asymmetry:.3g} % of √(A_ii·A_jj))")
+        for c, rows, cols in self._blocks():
+            ea, eb = r.err_a[np.ix_(rows, cols)], r.err_b[np.ix_(rows, cols)]
+            ia, ib = np.unravel_index(np.argmax(ea), ea.shape), np.unravel_index(np.argmax(eb), eb.shape)
+            lines.append(f"  coupling {c.name} ({c.body_a}, {c.body_b}): {len(c.kernels)} kernels; rebuilt A worst "
+                         f"{ea[ia]:.3g} % ({self.labels[rows[ia[0]]]}, {self.labels[cols[ia[1]]]}), B worst "
+                         f"{eb[ib]:.3g} % ({self.labels[rows[ib[0]]]}, {self.labels[cols[ib[1]]]}) of each curve's peak")
+        lines += [f"  WARNING: {w}" for w in r.warnings]
+        return lines
+
+    def _blocks(self):
+        """(coupling, its rows, its columns in the transform's matrices)."""
+        for c in self.couplings:
+            rows = [k for k, (b, _) in enumerate(self.dofs) if self.names[b] == c.body_a]
+            cols = [k for k, (b, _) in enumerate(self.dofs) if self.names[b] == c.body_b]
+            yield c, rows, cols
+
+
+def label(body, k):
+    return f"{body}__{DOF_NAMES[k - 1]}"
+
+
+def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SYMMETRY_TOL, prefix=None):
+    """Couplings of the BEM bodies mapped in ``bodies`` ({BEM body: name to use}).
+
+    dofs: dof names to keep ("Surge", …; default every dof in the file), each must be in the
+    file for every mapped body.  timdel, length [s]: asked kernel spacing and length.
+    prefix: coupling names are ``<prefix>_<a>`` (self) and ``<prefix>_<a>_<b>`` (cross), or
+    ``<a>`` and ``<a>_<b>`` without one.  Raises InputError naming the file and the field.
+    """
+    path = data.path
+    for b in bodies:
+        if b not in data.bodies:
+            raise InputError(path, None, "body", f"{b!r} is not a body of the result (it has: {', '.join(data.bodies)})")
+    want = list(DOF_NAMES) if dofs is None else list(dofs)
+    for name in want:
+        if name not in DOF_NAMES:
+            raise InputError(path, None, "dofs", f"{name!r} is not a dof name ({', '.join(DOF_NAMES)})")
+    keep = []
+    for b in data.bodies:
+        if b not in bodies:
+            continue
+        for name in want:
+            k = DOF_NAMES.index(name) + 1
+            i = data.index(b, k)
+            if i is None:
+                if dofs is not None:
+                    raise InputError(path, None, label(b, k), "missing dof: the scene asks for it, the file has "
+                                                              + ", ".join(label(*d) for d in data.dofs if d[0] == b))
+                continue
+            keep.append(i)
+    sel = np.ix_(range(data.omega.size), keep, keep)
+    kept = [data.dofs[i] for i in keep]
+    try:
+        rad = transform(data.omega, data.added_mass[sel], data.damping[sel],
+                        None if data.a_inf is None else data.a_inf[np.ix_(keep, keep)],
+                        units=[k >= 4 for _, k in kept], timdel=timdel, length=length, symmetry_tol=symmetry_tol)
+    except AsymmetryError as exc:
+        i, j = exc.pair
+        raise InputError(path, None, f"added_mass[inf][{label(*kept[i])}, {label(*kept[j])}]",
+                         f"infinite-frequency added mass asymmetric beyond the tolerance: {exc.a_ij:.6g} but "
+                         f"{exc.a_ji:.6g} for [{label(*kept[j])}, {label(*kept[i])}], {100 * exc.ratio:.3g} % of "
+                         f"√(A_ii·A_jj) > {100 * exc.tol:g} % (symmetry_tolerance)") from None
+    except GridError as exc:
+        raise InputError(path, None, exc.field, str(exc)) from None
+    out = []
+    order = [b for b in data.bodies if b in bodies]
+    for p, bp in enumerate(order):
+        for bq in order[p:]:
+            am = np.zeros((6, 6))
+            kernels = {}
+            for r, (b1, i) in enumerate(kept):
+                for c, (b2, j) in enumerate(kept):
+                    if b1 != bp or b2 != bq:
+                        continue
+                    am[i - 1, j - 1] = rad.a_inf[r, c]
+                    if rad.active[r, c] and np.any(rad.kernels[r, c]):
+                        kernels[(i, j)] = rad.kernels[r, c].copy()
+            na, nb = bodies[bp], bodies[bq]
+            name = "_".join(([prefix] if prefix else []) + ([na] if bp == bq else [na, nb]))
+            out.append(CouplingData(name, ("from BEM", path), na, nb, am, rad.timdel, kernels, path, None))
+    return BemCouplings(data, out, rad, kept, dict(bodies))
+
+
+def write_simo(result, path):
+    """Write ``couplings``' result as a SIMO deck: one BODY DATA group per body, then the
+    HYDRodynamic COUPling DATA groups (``decks.simo`` reads it back)."""
+    names = list(dict.fromkeys(n for c in result.couplings for n in (c.body_a, c.body_b)))
+    for n in names:
+        if len(n.split()) != 1:
+            raise InputError(path, None, "CHBDY", f"body name {n!r} must be one word")
+    groups = [[BODY, n] for n in names]
+    groups += [format_coupling(c.name, c.body_a, c.body_b, c.added_mass, c.kernels, c.timdel,
+                               text=(f"from {c.text[1]}", "written by hydrofmu bem2simo, SI units"))
+               for c in result.couplings]
+    return write_couplings(path, groups)
+
+
+def plot_quality(result, path, most=16):
+    """PNG: A(ω) and B(ω) of the database (dots) and rebuilt from (A∞, K) (lines) for the
+    diagonal pairs and the largest cross pairs (at most ``most`` pairs)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    r = result.radiation
+    n = len(result.labels)
+    scale = np.sqrt(np.outer(*(2 * [np.abs(np.diagonal(r.b_db, axis1=1, axis2=2)).max(axis=0)])))
+    size = np.max(np.abs(r.b_db), axis=0) / np.where(scale > 0, scale, 1)
+    pairs = [(i, i) for i in range(n) if r.active[i, i]]
+    cross = sorted(((size[i, j], i, j) for i in range(n) for j in range(i + 1, n) if r.active[i, j]), reverse=True)
+    pairs = (pairs + [(i, j) for _, i, j in cross])[:most]
+    fig, axes = plt.subplots(len(pairs), 2, figsize=(10, 1.8 * len(pairs) + 0.6), squeeze=False)
+    w = r.omega
+    for row, (i, j) in enumerate(pairs):
+        for ax, db, fit, err, what in ((axes[row, 0], r.a_db, r.a_fit, r.err_a, "A"),
+                                       (axes[row, 1], r.b_db, r.b_fit, r.err_b, "B")):
+            ax.plot(w, db[:, i, j], ".", ms=3, label="database")
+            ax.plot(w, fit[:, i, j], "-", lw=1, label="from A∞, K(t)")
+            ax.set_title(f"{what} {result.labels[i]}, {result.labels[j]}: worst {err[i, j]:.2g} % of peak", fontsize=8)
+            ax.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("ω [rad/s]", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path

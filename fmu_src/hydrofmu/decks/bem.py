@@ -1,0 +1,254 @@
+"""Readers for BEM radiation results: Capytaine datasets (NetCDF) and WAMIT `.1` files.
+
+Both give a ``BemData``: added mass A(ω) and radiation damping B(ω) in SI units on a grid of
+finite frequencies, the infinite-frequency added mass when the file has it, and the dofs as
+(body, k) with k = 1…6 (surge, sway, heave, roll, pitch, yaw) in the matrices' order.
+Element [i, j]: load in dof i per motion of dof j (Capytaine: influenced_dof i,
+radiating_dof j; WAMIT: I, J).
+
+Capytaine (needs the `bem` extra: xarray and netCDF4): the dataset as ``cpt.export_dataset``
+writes it: ``added_mass`` and ``radiation_damping`` over (omega, influenced_dof,
+radiating_dof) (or another frequency dimension with an ``omega`` coordinate), scalar
+``rho``, ``g``, ``water_depth`` (inf: deep water), ``forward_speed`` = 0, and
+``rotation_center`` per body.  Dof names: "Surge" … "Yaw" for one body, "<body>__Surge" …
+for several (Capytaine's joined bodies).  ω = ∞ is the infinite-frequency added mass, ω = 0
+the zero-frequency one (not used).
+
+WAMIT (manual, chapter 4): lines ``PER I J Ā [B̄]``, PER the period [s] (the default output,
+IPEROUT = 1), PER = −1 the infinite period (ω = 0) and PER = 0 the zero period (ω = ∞), both
+with Ā only.  Nondimensional with the length ULEN and the density ρ:
+A = Ā·ρ·L^k, B = B̄·ρ·L^k·ω, k = 3 for I, J ≤ 3 (of each body), 5 for both rotations, 4 mixed.
+Several bodies: I = 6·(body − 1) + k, bodies named "body1", "body2", …  A pair missing at
+a period is zero (WAMIT leaves out what it does not compute).
+"""
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+
+DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
+
+
+@dataclass
+class BemData:
+    """A BEM radiation result in SI units (see the module docstring).
+
+    omega (N,) [rad/s] finite, > 0, increasing; added_mass, damping (N, n, n); a_inf (n, n) or
+    None; dofs [(body, k)] (k 1…6); bodies [names] in file order; rotation_centers
+    {body: [x, y, z]} [m] when the file gives them; rho [kg/m³], g [m/s²], water_depth [m]
+    (inf: deep) or None when the file does not say; path: the file.
+    """
+    path: str
+    omega: np.ndarray
+    added_mass: np.ndarray
+    damping: np.ndarray
+    dofs: list
+    bodies: list
+    a_inf: np.ndarray = None
+    rotation_centers: dict = field(default_factory=dict)
+    rho: float = None
+    g: float = None
+    water_depth: float = None
+    kind: str = ""
+
+    def index(self, body, k):
+        """Row/column of (body, dof k) or None."""
+        try:
+            return self.dofs.index((body, k))
+        except ValueError:
+            return None
+
+
+def read_bem(path, ulen=None, rho=None):
+    """Read a Capytaine dataset (.nc) or a WAMIT .1 file (by its extension)."""
+    path = Path(path)
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        return read_capytaine(path)
+    if path.suffix == ".1":
+        return read_wamit(path, ulen, rho)
+    raise InputError(path, None, "bem", "expected a Capytaine NetCDF dataset (.nc) or a WAMIT .1 file")
+
+
+def _check_finite(path, name, values, coords):
+    """Error naming the variable and the coordinates of the first non-finite value."""
+    bad = ~np.isfinite(values)
+    if bad.any():
+        where = np.argwhere(bad)[0]
+        at = ", ".join(f"{k}={v[i]}" for (k, v), i in zip(coords, where))
+        raise InputError(path, None, name, f"{bad.sum()} non-finite value(s), first at {at} ({values[tuple(where)]})")
+
+
+def read_capytaine(path):
+    """Read a Capytaine NetCDF dataset: a BemData."""
+    path = Path(path)
+    try:
+        import xarray as xr
+    except ImportError:
+        raise InputError(path, None, "bem", "reading Capytaine datasets needs xarray and netCDF4: "
+                                             "pip install -e \".[bem]\"") from None
+    try:
+        ds = xr.load_dataset(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(path, None, "bem", f"cannot read as a NetCDF dataset ({exc})") from None
+    for var in ("added_mass", "radiation_damping"):
+        if var not in ds:
+            raise InputError(path, None, var, f"missing (variables: {', '.join(ds.data_vars) or 'none'}); "
+                                              "solve the radiation problems and export with cpt.export_dataset")
+    if "complex" in ds.dims:
+        ds = ds.sel(complex="re", drop=True) if "complex" in ds["added_mass"].dims else ds
+    scalars = {}
+    for name in ("rho", "g", "water_depth", "forward_speed"):
+        if name in ds.coords or name in ds:
+            v = np.atleast_1d(ds[name].values).astype(float)
+            if v.size != 1:
+                raise InputError(path, None, name, f"{v.size} values {v.tolist()}: select one "
+                                                   f"(ds.sel({name}=…)) before exporting")
+            scalars[name] = float(v[0])
+            if name in ds.dims:
+                ds = ds.squeeze(name, drop=True)
+    if scalars.get("forward_speed", 0.0) != 0.0:
+        raise InputError(path, None, "forward_speed", f"{scalars['forward_speed']:g} m/s: only zero speed results "
+                                                      "give Cummins' kernels")
+    am = ds["added_mass"]
+    extra = [d for d in am.dims if d not in ("influenced_dof", "radiating_dof")]
+    dims_ok = "influenced_dof" in am.dims and "radiating_dof" in am.dims and len(extra) == 1
+    if not dims_ok:
+        raise InputError(path, None, "added_mass", f"expected dimensions (frequency, influenced_dof, radiating_dof), "
+                                                   f"found {am.dims}")
+    freq = extra[0]
+    if freq == "omega":
+        omega = ds["omega"].values.astype(float)
+    elif "omega" in ds.coords and ds["omega"].dims == (freq,):
+        omega = ds["omega"].values.astype(float)
+    else:
+        raise InputError(path, None, "omega", f"no angular frequency coordinate along {freq!r}")
+    rows = [str(x) for x in ds["influenced_dof"].values]
+    cols = [str(x) for x in ds["radiating_dof"].values]
+    if set(rows) != set(cols):
+        miss = sorted(set(rows) ^ set(cols))
+        raise InputError(path, None, "radiating_dof", f"missing dof(s) {', '.join(miss)}: radiating and influenced "
+                                                      f"dofs must be the same set")
+    order = [cols.index(r) for r in rows]
+    a = am.transpose(freq, "influenced_dof", "radiating_dof").values.astype(float)[:, :, order]
+    b = ds["radiation_damping"].transpose(freq, "influenced_dof", "radiating_dof").values.astype(float)[:, :, order]
+    dofs, bodies = [], []
+    for name in rows:
+        body, _, dof = name.rpartition("__")
+        if not body:
+            body = _single_name(ds)
+        if dof not in DOF_NAMES:
+            raise InputError(path, None, "radiating_dof", f"{name!r} is not a rigid-body dof "
+                                                          f"({', '.join(DOF_NAMES)}, or <body>__<dof>)")
+        if (body, DOF_NAMES.index(dof) + 1) in dofs:
+            raise InputError(path, None, "radiating_dof", f"dof {name!r} appears twice")
+        dofs.append((body, DOF_NAMES.index(dof) + 1))
+        if body not in bodies:
+            bodies.append(body)
+    coords = [(freq, omega), ("influenced_dof", rows), ("radiating_dof", rows)]
+    inf = np.isinf(omega)
+    fin = np.isfinite(omega) & (omega > 0)
+    if np.isnan(omega).any():
+        raise InputError(path, None, "omega", "NaN frequency")
+    for name, v in (("added_mass", a), ("radiation_damping", b)):
+        sel = fin | inf if name == "added_mass" else fin
+        _check_finite(path, name, v[sel], [(freq, omega[sel])] + coords[1:])
+    k = np.argsort(omega[fin])
+    w = omega[fin][k]
+    if np.any(np.diff(w) <= 0):
+        raise InputError(path, None, "omega", "repeated frequency")
+    centres = {}
+    if "rotation_center" in ds.coords or "rotation_center" in ds:
+        rc = ds["rotation_center"]
+        if "body" in rc.dims:
+            centres = {str(n): rc.sel(body=n).values.astype(float).tolist() for n in rc["body"].values}
+        else:
+            centres = {bodies[0]: rc.values.astype(float).tolist()}
+    return BemData(str(path), w, a[fin][k], b[fin][k], dofs, bodies,
+                   a_inf=a[inf][0] if inf.any() else None, rotation_centers=centres,
+                   rho=scalars.get("rho"), g=scalars.get("g"), water_depth=scalars.get("water_depth"),
+                   kind="Capytaine")
+
+
+def _single_name(ds):
+    """Name of the body of a one-body dataset (dofs without a '<body>__' prefix)."""
+    if "body" in ds.coords and ds["body"].size == 1:
+        return str(np.atleast_1d(ds["body"].values)[0])
+    return "body"
+
+
+def _wamit_k(i, j):
+    """The length exponent of Ā_ij (WAMIT): 3 translation–translation, 4 mixed, 5 rotations."""
+    return 3 + ((i - 1) % 6 >= 3) + ((j - 1) % 6 >= 3)
+
+
+def read_wamit(path, ulen, rho):
+    """Read a WAMIT .1 file; ``ulen`` [m] and ``rho`` [kg/m³] make it dimensional."""
+    path = Path(path)
+    if ulen is None or not ulen > 0:
+        raise InputError(path, None, "ulen", "a WAMIT .1 file is nondimensional: declare ULEN (ulen = … m), "
+                                             "the length of the run's .gdf")
+    if rho is None or not rho > 0:
+        raise InputError(path, None, "rho", "declare the density that makes the WAMIT file dimensional")
+    try:
+        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+    except OSError as exc:
+        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
+    rows = {}   # period → {(I, J): (A, B)}
+    first = {}
+    for number, line in enumerate(text, 1):
+        words = line.replace(",", " ").split()
+        if not words:
+            continue
+        names = ["PER", "I", "J", "A", "B"]
+        if len(words) not in (4, 5):
+            raise InputError(path, number, "PER I J A B", f"expected 4 or 5 numbers, found {len(words)}: {line.strip()!r}")
+        vals = []
+        for name, w in zip(names, words):
+            try:
+                vals.append(float(w.replace("D", "E").replace("d", "e")))
+            except ValueError:
+                raise InputError(path, number, name, f"not a number: {w!r}") from None
+            if not np.isfinite(vals[-1]):
+                raise InputError(path, number, name, f"non-finite value {w!r}")
+        per, i, j = vals[0], vals[1], vals[2]
+        for name, v in (("I", i), ("J", j)):
+            if v != int(v) or v < 1:
+                raise InputError(path, number, name, f"dof index must be a positive integer, found {v:g}")
+        i, j = int(i), int(j)
+        special = per in (-1.0, 0.0)
+        if per < 0 and not special:
+            raise InputError(path, number, "PER", f"period must be > 0, −1 (infinite) or 0 (zero), found {per:g}")
+        if not special and len(vals) != 5:
+            raise InputError(path, number, "B", f"missing the damping at period {per:g} s")
+        key = (per, i, j)
+        if key in first:
+            raise InputError(path, number, "I J", f"duplicate (PER, I, J) = ({per:g}, {i}, {j}) "
+                                                  f"(first at line {first[key]})")
+        first[key] = number
+        rows.setdefault(per, {})[(i, j)] = (vals[3], vals[4] if len(vals) == 5 else 0.0)
+    periods = sorted((p for p in rows if p > 0), reverse=True)          # increasing ω
+    if len(periods) < 3:
+        raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 3 needed")
+    index = sorted({i for r in rows.values() for ij in r for i in ij})
+    n = len(index)
+    pos = {d: k for k, d in enumerate(index)}
+    scale = np.array([[rho * ulen ** _wamit_k(i, j) for j in index] for i in index])
+
+    def matrices(r, col):
+        m = np.zeros((n, n))
+        for (i, j), v in r.items():
+            m[pos[i], pos[j]] = v[col]
+        return m * scale
+    omega = 2 * np.pi / np.array(periods)
+    a = np.array([matrices(rows[p], 0) for p in periods])
+    b = np.array([matrices(rows[p], 1) for p in periods]) * omega[:, None, None]
+    nb = (max(index) - 1) // 6 + 1
+    bodies = [f"body{k + 1}" for k in range(nb)]
+    dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in index]
+    bodies = [x for x in bodies if any(d[0] == x for d in dofs)]
+    return BemData(str(path), omega, a, b, dofs, bodies,
+                   a_inf=matrices(rows[0.0], 0) if 0.0 in rows else None,
+                   rho=None, g=None, water_depth=None, kind="WAMIT")
+

@@ -1,0 +1,281 @@
+"""Frequency-domain radiation coefficients → infinite-frequency added mass and retardation kernels.
+
+Input: added mass A(ω) and radiation damping B(ω) (n×n matrices per frequency, element [i, j] =
+load in dof i per motion of dof j, SI: kg, kg·m, kg·m², N·s/m, N·s, N·m·s), on a grid
+0 < ω₁ < … < ω_N [rad/s], and optionally A∞ from the file.  Output (Cummins):
+
+    F(t) = −A∞·a(t) − ∫₀^∞ K(s)·v(t − s) ds,   K(t) = (2/π)·∫₀^∞ B(ω)·cos(ωt) dω,
+
+the kernels sampled at t = 0, TIMDEL, 2·TIMDEL, … (``memory.Convolution``'s convention: linear
+between samples, zero after the last).  Method (stated in the README):
+
+- B between the grid points: linear; below ω₁: linear from B(0) = 0; above ω_N: a power tail
+  B(ω) = B(ω_N)·(ω_N/ω)^p, one exponent p for all pairs, fitted to the diagonal terms over the top
+  fifth of the grid and kept within [P_MIN, P_MAX], integrated on a geometric grid up to
+  TAIL_SPAN·ω_N.  The cosine transform of this piecewise-linear B is exact (closed form per
+  segment), so K carries no quadrature error of its own.
+- TIMDEL = π/(TIMDEL_FACTOR·ω_N) unless asked; an asked TIMDEL above π/(TIMDEL_LIMIT·ω_N) cannot
+  represent the grid's highest frequencies and is refused.
+- Kernel length: the time after which every kept |K_ij| stays below DECAY of its peak (capped
+  at the 2π/Δω the grid's spacing resolves), unless asked.
+- A∞: the file's infinite-frequency value when given; else Ogilvie's relation
+  A∞ = A(ω) + (1/ω)·∫₀^L K(t)·sin(ωt) dt averaged over the top third of the grid.
+- Symmetry: A∞, A(ω) and B(ω) are symmetrised; an A∞ asymmetry |A_ij − A_ji| above
+  ``symmetry_tol``·√(|A_ii|·|A_jj|) is an error (``AsymmetryError``).
+- Negligible dofs and pairs (below NEGLIGIBLE of their diagonal scale) are set to zero.
+
+Quality: A(ω) = A∞ − (1/ω)·∫K̃(t)·sin(ωt) dt and B(ω) = ∫K̃(t)·cos(ωt) dt rebuilt from the
+sampled kernel K̃ exactly as the FMU convolves it, compared with the database at its own
+frequencies: worst error in % of each curve's peak; ``tail_share`` = share of ∫|B| dω beyond ω_N.
+"""
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+TIMDEL_FACTOR = 12.0     # default TIMDEL = π/(12·ω_N): 24 samples per period of ω_N
+TIMDEL_LIMIT = 8.0       # asked TIMDEL must be ≤ π/(8·ω_N)
+DECAY = 0.002            # kernel ends where every kept |K_ij| stays below 0.2 % of its peak
+P_MIN, P_MAX = 2.0, 8.0  # tail exponent bounds
+TAIL_SPAN = 50.0         # the tail is integrated up to 50·ω_N (its rest: (1/50)^(p−1) of it)
+TAIL_WARN = 0.05         # warn when the tail carries more than 5 % of ∫|B| dω
+NEGLIGIBLE = 1e-6        # pairs below 1e-6·√(s_i·s_j) are zero
+SYMMETRY_TOL = 0.01      # default A∞ asymmetry tolerance (relative to √(|A_ii|·|A_jj|))
+
+
+class AsymmetryError(ValueError):
+    """A∞ asymmetric beyond the tolerance: ``pair`` (i, j) 0-based, values and the tolerance."""
+
+    def __init__(self, pair, a_ij, a_ji, ratio, tol):
+        self.pair, self.a_ij, self.a_ji, self.ratio, self.tol = pair, a_ij, a_ji, ratio, tol
+        super().__init__(f"A∞[{pair[0]}, {pair[1]}] = {a_ij:.6g} but A∞[{pair[1]}, {pair[0]}] = {a_ji:.6g}: "
+                         f"asymmetry {100 * ratio:.3g} % of √(A_ii·A_jj) exceeds {100 * tol:g} %")
+
+
+class GridError(ValueError):
+    """The frequency grid cannot give what was asked (``field``: 'timdel' or 'omega')."""
+
+    def __init__(self, field, message):
+        self.field = field
+        super().__init__(message)
+
+
+@dataclass
+class Radiation:
+    """Result of ``transform`` (n dofs, SI units).
+
+    a_inf (n, n) [kg, kg·m, kg·m²]; kernels (n, n, nt) [N·s/m², …] at t = k·timdel [s];
+    active (n, n) bool: the pairs kept; omega, a_db, b_db: the (symmetrised) database;
+    a_fit, b_fit: the same rebuilt from (a_inf, kernels); err_a, err_b (n, n): worst error in %
+    of each curve's peak; tail_share (n, n); notes: what the transform decided (text lines).
+    """
+    a_inf: np.ndarray
+    timdel: float
+    kernels: np.ndarray
+    active: np.ndarray
+    omega: np.ndarray
+    a_db: np.ndarray
+    b_db: np.ndarray
+    a_fit: np.ndarray
+    b_fit: np.ndarray
+    err_a: np.ndarray
+    err_b: np.ndarray
+    tail_share: np.ndarray
+    tail_exponent: float
+    a_inf_source: str
+    asymmetry: float
+    seconds: float
+    notes: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+    @property
+    def length(self):
+        """Kernel length [s] (time of the last sample)."""
+        return self.timdel * (self.kernels.shape[-1] - 1)
+
+
+def _sinc_g(y):
+    """sin(y)/y and g(y) = (sin y − y·cos y)/y³ without cancellation (series for small y)."""
+    sy, cy = np.sin(y), np.cos(y)
+    small = np.abs(y) < 1e-2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sinc = sy / y
+        g = (sy - y * cy) / y ** 3
+    if small.any():
+        y2 = y[small] ** 2
+        sinc[small] = 1 - y2 / 6 + y2 ** 2 / 120
+        g[small] = 1 / 3 - y2 / 30 + y2 ** 2 / 840
+    return sinc, g
+
+
+def hat_transform(nodes, x, kind="cos"):
+    """W (len(x), len(nodes)) with W @ f = ∫ f(s)·cos(x·s) ds (or sin) over [nodes[0], nodes[-1]]
+    for f linear between its values at ``nodes`` (exact, closed form per segment:
+    ∫ over [m − h, m + h] of (f_m + f'·(s − m))·cos(xs) ds = 2h·f_m·cos(xm)·sinc(xh)
+    − 2h³·x·f'·sin(xm)·g(xh), g(y) = (sin y − y·cos y)/y³; likewise for sin)."""
+    nodes, x = np.asarray(nodes, float), np.asarray(x, float)[:, None]
+    m, h = 0.5 * (nodes[1:] + nodes[:-1]), 0.5 * (nodes[1:] - nodes[:-1])
+    sinc, g = _sinc_g(x * h)
+    xm = x * m
+    cm, sm = np.cos(xm), np.sin(xm)
+    if kind == "cos":
+        c0, c1 = 2 * h * cm * sinc, -2 * h ** 3 * x * sm * g
+    else:
+        c0, c1 = 2 * h * sm * sinc, 2 * h ** 3 * x * cm * g
+    # f on a segment = f_m + f'·(s − m): f_m = (f_a + f_b)/2, f' = (f_b − f_a)/(2h)
+    w = np.zeros((x.shape[0], nodes.size))
+    w[:, :-1] += 0.5 * c0 - c1 / (2 * h)
+    w[:, 1:] += 0.5 * c0 + c1 / (2 * h)
+    return w
+
+
+def _tail_exponent(omega, b, active):
+    """Common decay exponent p of B ~ ω^−p from the diagonals over the top fifth of the grid."""
+    top = omega >= omega[-1] - 0.2 * (omega[-1] - omega[0])
+    if top.sum() < 2:
+        top[-2:] = True
+    slopes = []
+    for i in range(b.shape[1]):
+        y = np.abs(b[top, i, i])
+        if active[i, i] and np.all(y > 0):
+            slopes.append(-np.polyfit(np.log(omega[top]), np.log(y), 1)[0])
+    p = float(np.median(slopes)) if slopes else P_MIN
+    return float(np.clip(p, P_MIN, P_MAX))
+
+
+def _scales(mats):
+    """Per dof: the largest |diagonal| over the matrices (mats: (..., n, n))."""
+    return np.max(np.abs(np.diagonal(mats, axis1=-2, axis2=-1)).reshape(-1, mats.shape[-1]), axis=0)
+
+
+def _negligible(a, b, a_inf, units):
+    """Active dofs and pairs: a dof is inactive when its diagonal scale is below NEGLIGIBLE of the
+    largest of its kind (``units``: 0 translation, 1 rotation); a pair when A and B both are."""
+    sa = _scales(np.concatenate([a, a_inf[None]]) if a_inf is not None else a)
+    sb = _scales(b)
+    on = np.ones(sa.size, bool)
+    for u in (0, 1):
+        k = units == u
+        if k.any():
+            on[k] &= (sa[k] > NEGLIGIBLE * sa[k].max()) | (sb[k] > NEGLIGIBLE * max(sb[k].max(), 1e-300))
+    scale_a, scale_b = np.sqrt(np.outer(sa, sa)), np.sqrt(np.outer(sb, sb))
+    peak_a = np.max(np.abs(np.concatenate([a, a_inf[None]]) if a_inf is not None else a), axis=0)
+    peak_b = np.max(np.abs(b), axis=0)
+    pairs = (peak_a > NEGLIGIBLE * scale_a) | (peak_b > NEGLIGIBLE * scale_b)
+    return pairs & np.outer(on, on), scale_a
+
+
+def symmetrise(a_inf, scale, tol):
+    """(A∞ + A∞ᵀ)/2 and the largest asymmetry ratio; AsymmetryError beyond ``tol``."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(scale > 0, np.abs(a_inf - a_inf.T) / scale, 0.0)
+    i, j = np.unravel_index(np.argmax(ratio), ratio.shape)
+    if ratio[i, j] > tol:
+        raise AsymmetryError((int(min(i, j)), int(max(i, j))), a_inf[min(i, j), max(i, j)],
+                             a_inf[max(i, j), min(i, j)], float(ratio[i, j]), tol)
+    return 0.5 * (a_inf + a_inf.T), float(ratio[i, j])
+
+
+def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, length=None,
+              symmetry_tol=SYMMETRY_TOL):
+    """A∞ and K(t) from A(ω), B(ω) (see the module docstring).
+
+    omega (N,) [rad/s], finite, > 0, increasing; added_mass, damping (N, n, n); a_inf (n, n) or
+    None (then extrapolated); units (n,) 0 for a translation dof, 1 for a rotation (default: dof
+    index mod 6 ≥ 3); timdel [s], length [s]: asked values or None.  Raises AsymmetryError,
+    GridError.  Returns a ``Radiation``.
+    """
+    t0 = time.perf_counter()
+    omega = np.asarray(omega, float)
+    a, b = np.asarray(added_mass, float), np.asarray(damping, float)
+    n = a.shape[-1]
+    units = np.asarray(units if units is not None else (np.arange(n) % 6 >= 3), int)
+    notes, warnings = [], []
+    if omega.size < 3 or np.any(np.diff(omega) <= 0) or omega[0] <= 0 or not np.isfinite(omega[-1]):
+        raise GridError("omega", "frequencies must be finite, > 0, increasing, at least 3")
+    active, scale = _negligible(a, b, None if a_inf is None else np.asarray(a_inf, float), units)
+    asym = 0.0
+    if a_inf is not None:
+        a_inf, asym = symmetrise(np.asarray(a_inf, float), scale, symmetry_tol)
+    a = 0.5 * (a + a.transpose(0, 2, 1))
+    b = 0.5 * (b + b.transpose(0, 2, 1))
+    a, b = a * active, b * active
+
+    w_top = omega[-1]
+    limit = np.pi / (TIMDEL_LIMIT * w_top)
+    if timdel is None:
+        timdel = np.pi / (TIMDEL_FACTOR * w_top)
+    elif timdel > limit * (1 + 1e-9):
+        raise GridError("timdel", f"TIMDEL = {timdel:g} s is too coarse for the frequency grid: its highest "
+                                  f"frequency {w_top:g} rad/s needs TIMDEL ≤ π/({TIMDEL_LIMIT:g}·ω_N) = {limit:.4g} s")
+    p = _tail_exponent(omega, b, active)
+    tail = w_top * np.geomspace(1.0, TAIL_SPAN, 400)[1:]
+    nodes = np.concatenate([[0.0], omega, tail])
+    bn = np.concatenate([np.zeros((1, n, n)), b, b[-1] * (w_top / tail[:, None, None]) ** p])
+
+    band = np.trapezoid(np.abs(bn[: omega.size + 1]), nodes[: omega.size + 1], axis=0)
+    beyond = np.abs(b[-1]) * w_top / (p - 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(active, beyond / (band + beyond), 0.0)
+    share = np.nan_to_num(share)
+
+    dw = np.max(np.diff(np.concatenate([[0.0], omega])))
+    cap = 2 * np.pi / dw
+    flat_b = bn.reshape(nodes.size, -1)
+
+    def sampled(t):
+        return (2 / np.pi) * (hat_transform(nodes, t) @ flat_b).reshape(t.size, n, n)
+    if length is None:   # find where the kernels have decayed on a coarser time grid first
+        t = 4 * timdel * np.arange(int(np.ceil(cap / (4 * timdel))) + 1)
+        k = sampled(t)
+        peak = np.max(np.abs(k), axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.where(active & (peak > 0), np.abs(k) / peak, 0.0).max(axis=(1, 2))
+        above = np.nonzero(rel > DECAY)[0]
+        last = int(above[-1]) + 1 if above.size else 1
+        if last >= t.size - 1:
+            warnings.append(f"the kernels have not decayed to {100 * DECAY:g} % of their peak within "
+                            f"2π/Δω = {cap:.4g} s, the longest memory the frequency spacing Δω = {dw:.4g} rad/s "
+                            f"resolves: refine the grid")
+        length = t[min(last, t.size - 1)]
+    t = timdel * np.arange(int(np.ceil(length / timdel - 1e-9)) + 1)
+    k = sampled(t)
+    kernels = np.ascontiguousarray(k.transpose(1, 2, 0))
+
+    # rebuild A(ω), B(ω) from the sampled kernels, as the convolution sees them
+    flat = kernels.reshape(n * n, -1).T
+    c = (hat_transform(t, omega) @ flat).reshape(omega.size, n, n)
+    s = (hat_transform(t, omega, "sin") @ flat).reshape(omega.size, n, n)
+    if a_inf is None:
+        top = omega >= omega[-1] - (omega[-1] - omega[0]) / 3
+        est = a[top] + s[top] / omega[top, None, None]
+        a_inf = est.mean(axis=0) * active
+        spread = np.max(np.abs(est - a_inf), axis=0)
+        src = "extrapolated"
+        notes.append(f"A∞ extrapolated (Ogilvie) over {top.sum()} frequencies ≥ {omega[top][0]:g} rad/s; "
+                     f"largest spread {100 * np.max(np.where(active, spread, 0) / np.where(scale > 0, scale, 1)):.3g} "
+                     f"% of √(A_ii·A_jj)")
+    else:
+        a_inf = a_inf * active
+        src = "file"
+    a_fit = a_inf[None] - s / omega[:, None, None]
+    b_fit = c
+
+    def worst(fit, db):
+        peak = np.max(np.abs(db), axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            e = np.where(active & (peak > 0), 100 * np.max(np.abs(fit - db), axis=0) / peak, 0.0)
+        return np.nan_to_num(e)
+
+    notes.insert(0, f"TIMDEL {timdel:.4g} s, kernel length {t[-1]:.4g} s ({t.size} samples), "
+                    f"tail B ~ ω^-{p:.3g} beyond {w_top:g} rad/s, A∞ from the {src}")
+    big = share > TAIL_WARN
+    if big.any():
+        i, j = np.unravel_index(np.argmax(share), share.shape)
+        warnings.append(f"the frequency range is short for the kernels: the tail beyond {w_top:g} rad/s carries "
+                        f"{100 * share[i, j]:.3g} % of ∫|B|dω for pair ({i}, {j}) (> {100 * TAIL_WARN:g} %, "
+                        f"{int(big.sum())} pair(s)); extend the frequencies")
+    return Radiation(a_inf=a_inf, timdel=float(timdel), kernels=kernels, active=active, omega=omega,
+                     a_db=a, b_db=b, a_fit=a_fit, b_fit=b_fit, err_a=worst(a_fit, a), err_b=worst(b_fit, b),
+                     tail_share=share, tail_exponent=p, a_inf_source=src, asymmetry=asym,
+                     seconds=time.perf_counter() - t0, notes=notes, warnings=warnings)
