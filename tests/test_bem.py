@@ -110,6 +110,37 @@ def test_wamit_bad_lines_name_line_and_field(tmp_path, text, field):
     assert exc.value.line == 2 and exc.value.field == field and str(f) in str(exc.value)
 
 
+def test_extrapolated_a_inf_close_to_capytaine_infinite_frequency():
+    """Without the file's ω = ∞ row, Ogilvie's extrapolation lands within 1 % of Capytaine's
+    infinite-frequency solution on every diagonal term (and within 1 % of √(A_ii·A_jj) off it)."""
+    from hydrofmu.bem import couplings
+    d = read_capytaine(CYL)
+    ref = d.a_inf.copy()
+    d.a_inf = None
+    r = couplings(d, {"cyl1": "cyl1", "cyl2": "cyl2"}).radiation
+    assert r.a_inf_source == "extrapolated"
+    on = np.diag(r.active)
+    diag = np.diag(ref)[on]
+    np.testing.assert_allclose(np.diag(r.a_inf)[on], diag, rtol=0.01)
+    scale = np.sqrt(np.outer(np.abs(np.diag(ref)), np.abs(np.diag(ref))))
+    assert np.max(np.abs(r.a_inf - ref * r.active)[r.active] / scale[r.active]) < 0.01
+
+
+def test_capytaine_regenerates_the_test_data():
+    """The committed dataset is what tests/data/bem/make_cylinders.py makes (one frequency
+    and ω = ∞ solved again; needs capytaine, which only this test uses)."""
+    pytest.importorskip("capytaine")
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("make_cylinders", CYL.with_name("make_cylinders.py"))
+    make = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make)
+    new = make.solve([2.5, np.inf])
+    old = xr.load_dataset(CYL).sel(omega=[2.5, np.inf])
+    for var in ("added_mass", "radiation_damping"):
+        a, b = new[var].transpose(*old[var].dims).values, old[var].values
+        np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9 * np.abs(b).max())
+
+
 # --- scenes: quality report and the built FMUs against the BEM values -----------------
 
 def test_scene_couplings_and_build_report(tmp_path):

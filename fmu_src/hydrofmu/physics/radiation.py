@@ -177,18 +177,20 @@ def symmetrise(a_inf, scale, tol):
 
 
 def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, length=None,
-              symmetry_tol=SYMMETRY_TOL):
+              symmetry_tol=SYMMETRY_TOL, labels=None):
     """A∞ and K(t) from A(ω), B(ω) (see the module docstring).
 
     omega (N,) [rad/s], finite, > 0, increasing; added_mass, damping (N, n, n); a_inf (n, n) or
     None (then extrapolated); units (n,) 0 for a translation dof, 1 for a rotation (default: dof
-    index mod 6 ≥ 3); timdel [s], length [s]: asked values or None.  Raises AsymmetryError,
+    index mod 6 ≥ 3); timdel [s], length [s]: asked values or None; labels: dof names for the
+    messages.  Raises AsymmetryError,
     GridError.  Returns a ``Radiation``.
     """
     t0 = time.perf_counter()
     omega = np.asarray(omega, float)
     a, b = np.asarray(added_mass, float), np.asarray(damping, float)
     n = a.shape[-1]
+    names = list(labels) if labels is not None else [str(k) for k in range(n)]
     units = np.asarray(units if units is not None else (np.arange(n) % 6 >= 3), int)
     notes, warnings = [], []
     if omega.size < 3 or np.any(np.diff(omega) <= 0) or omega[0] <= 0 or not np.isfinite(omega[-1]):
@@ -197,6 +199,13 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
     asym = 0.0
     if a_inf is not None:
         a_inf, asym = symmetrise(np.asarray(a_inf, float), scale, symmetry_tol)
+    for name, m in (("A(ω)", a), ("B(ω)", b)):
+        d = _scales(m)
+        ref = np.sqrt(np.outer(d, d))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = np.where(active & (ref > 0), np.max(np.abs(m - m.transpose(0, 2, 1)), axis=0) / ref, 0.0)
+        notes.append(f"database {name} symmetrised: largest |M_ij − M_ji| {100 * np.nan_to_num(r).max():.3g} % "
+                     f"of √(M_ii·M_jj) (peaks)")
     a = 0.5 * (a + a.transpose(0, 2, 1))
     b = 0.5 * (b + b.transpose(0, 2, 1))
     a, b = a * active, b * active
@@ -273,7 +282,7 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
     if big.any():
         i, j = np.unravel_index(np.argmax(share), share.shape)
         warnings.append(f"the frequency range is short for the kernels: the tail beyond {w_top:g} rad/s carries "
-                        f"{100 * share[i, j]:.3g} % of ∫|B|dω for pair ({i}, {j}) (> {100 * TAIL_WARN:g} %, "
+                        f"{100 * share[i, j]:.3g} % of ∫|B|dω for ({names[i]}, {names[j]}) (> {100 * TAIL_WARN:g} %, "
                         f"{int(big.sum())} pair(s)); extend the frequencies")
     return Radiation(a_inf=a_inf, timdel=float(timdel), kernels=kernels, active=active, omega=omega,
                      a_db=a, b_db=b, a_fit=a_fit, b_fit=b_fit, err_a=worst(a_fit, a), err_b=worst(b_fit, b),

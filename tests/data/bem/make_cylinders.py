@@ -27,13 +27,19 @@ def cylinder(name, y):
                             center_of_mass=(0.0, y, -DRAFT / 2), name=name)
 
 
-def main(out):
+def solve(omega=OMEGA):
+    """The radiation dataset of the two cylinders at the frequencies ``omega`` [rad/s]."""
+    import xarray as xr
     bodies = cylinder("cyl1", -GAP_CENTRES / 2) + cylinder("cyl2", GAP_CENTRES / 2)
-    grid = __import__("xarray").Dataset(coords={"omega": OMEGA, "radiating_dof": list(bodies.dofs),
-                                                "water_depth": [np.inf], "rho": [RHO], "g": [G]})
-    ds = cpt.BEMSolver().fill_dataset(grid, bodies, hydrostatics=False)
+    grid = xr.Dataset(coords={"omega": np.asarray(omega, float), "radiating_dof": list(bodies.dofs),
+                              "water_depth": [np.inf], "rho": [RHO], "g": [G]})
+    return cpt.BEMSolver().fill_dataset(grid, bodies, hydrostatics=False)
+
+
+def main(out):
+    ds = solve()
     cpt.export_dataset(str(out), ds)
-    print(f"wrote {out}: {len(bodies.dofs)} dofs, {OMEGA.size} frequencies, {Path(out).stat().st_size} bytes")
+    print(f"wrote {out}: {ds.sizes['radiating_dof']} dofs, {OMEGA.size} frequencies, {Path(out).stat().st_size} bytes")
 
 
 if __name__ == "__main__":
