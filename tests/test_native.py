@@ -8,6 +8,7 @@ shim has to find, start and check Python itself.  Results are compared with our 
 master (libcosim's fixed-step algorithm is a Jacobi scheme) and with the same FMU driven
 in-process by fmpy.
 """
+import json
 import os
 import re
 import shutil
@@ -101,11 +102,151 @@ def assert_equals_jacobi(tables, folder, stop, step):
 @pytest.mark.parametrize("name", SCENES)
 def test_libcosim_native_host_runs_osp_system_structure(name, scenes, hosts, tmp_path):
     folder = scenes[name]
-    step = __import__("json").loads((folder / "manifest.json").read_text())["run"]["step"]
+    step = json.loads((folder / "manifest.json").read_text())["run"]["step"]
     stop = STEPS * step
     tables = run_cosim(hosts, folder / "OspSystemStructure.xml", stop, step, tmp_path / "out")
     ours = assert_equals_jacobi(tables, folder, stop, step)
     assert np.ptp(ours.values, axis=0).max() > 0  # something moves
+
+
+HOST_PACKAGES = ("numpy", "scipy")  # what the README says a host's Python needs
+
+
+@pytest.fixture(scope="module")
+def host_venv(tmp_path_factory):
+    """A fresh venv holding exactly HOST_PACKAGES (linked from this environment's
+    installation, which is what pip would unpack: no index needed, no time spent)."""
+    import importlib.metadata as meta
+    venv = tmp_path_factory.mktemp("hostvenv") / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
+    site = next(venv.glob("lib/python3*/site-packages"))
+    for name in HOST_PACKAGES:
+        dist = meta.distribution(name)
+        tops = {Path(str(f)).parts[0] for f in dist.files if not str(f).startswith("..")}
+        for top in tops:  # the package, its bundled libraries (numpy.libs) and its dist-info
+            src = Path(dist.locate_file(top))
+            if src.exists() and not (site / top).exists():
+                (site / top).symlink_to(src)
+    return venv / "bin" / "python"
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_host_with_exactly_the_readme_packages_runs_every_fmu(name, scenes, hosts, host_venv, tmp_path):
+    check = subprocess.run([str(host_venv), "-c", "import numpy, scipy, pkgutil, sys; "
+                            "print(sorted(m.name for m in pkgutil.iter_modules(sys.path[-1:])))"],
+                           capture_output=True, text=True, env=clean_env())
+    assert check.returncode == 0 and "pythonfmu" not in check.stdout and "fmpy" not in check.stdout, check
+    folder = scenes[name]
+    step = json.loads((folder / "manifest.json").read_text())["run"]["step"]
+    tables = run_cosim(hosts, folder / "OspSystemStructure.xml", 5 * step, step, tmp_path / "out",
+                       env=clean_env(HYDROFMU_PYTHON=str(host_venv)))
+    assert_equals_jacobi(tables, folder, 5 * step, step)
+
+
+def test_every_fmu_of_models_validates(scenes):
+    from fmpy.validation import validate_fmu
+    problems = {f.name: validate_fmu(str(f)) for folder in scenes.values() for f in folder.glob("*.fmu")}
+    assert len(problems) >= 7 and not any(problems.values()), problems
+
+
+# -- SSP ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", SCENES)
+def test_ssp_validates_and_runs_in_libcosim_native(name, scenes, hosts, tmp_path):
+    """<scene>.ssp passes fmpy's SSP schema validation and, loaded by libcosim's SSP
+    loader in the native host (step from the file's annotation), equals our Jacobi run."""
+    from fmpy.ssp.ssd import read_ssd
+    folder = scenes[name]
+    ssp = folder / f"{name}.ssp"
+    ssd = read_ssd(str(ssp), validate=True)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert sorted(c.name for c in ssd.system.elements) == sorted(manifest["instances"])
+    assert len(ssd.system.connections) == len(manifest["connections"])
+    step = manifest["run"]["step"]
+    tables = run_cosim(hosts, ssp, STEPS * step, 0, tmp_path / "out")
+    assert_equals_jacobi(tables, folder, STEPS * step, step)
+
+
+def test_ssp_contents(scenes):
+    """Units with their SI exponents, parameters bound to the values the build gave, and
+    the default experiment: what an SSP importer reads without opening the FMUs."""
+    from xml.etree import ElementTree as ET
+    from fmpy import read_model_description
+    from hydrofmu.fmi.ssp import SSC, SSD, SSV, base_unit
+    folder = scenes["moored_barge"]
+    with zipfile.ZipFile(folder / "moored_barge.ssp") as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+        assert sorted(n for n in z.namelist() if n.endswith(".fmu")) == sorted(
+            f"resources/{p.name}" for p in folder.glob("*.fmu"))
+    ns = {"ssd": SSD, "ssc": SSC, "ssv": SSV}
+    exp = root.find("ssd:DefaultExperiment", ns)
+    assert float(exp.get("stopTime")) == 600.0 and 'baseStepSize="0.1"' in ET.tostring(exp, encoding="unicode")
+    units = {u.get("name"): u.find("ssc:BaseUnit", ns).attrib for u in root.iter(f"{{{SSC}}}Unit")}
+    assert units["N.m"] == {"kg": "1", "m": "2", "s": "-2"} and units["kg.m2"] == {"kg": "1", "m": "2"}
+    assert units["m/s2"] == {"m": "1", "s": "-2"} and units["kg/m3"] == {"kg": "1", "m": "-3"}
+    assert base_unit("deg") == {"rad": "1", "factor": repr(np.pi / 180)}
+    for comp in root.iter(f"{{{SSD}}}Component"):
+        md = read_model_description(str(folder / Path(comp.get("source")).name))
+        start = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
+        bound = {p.get("name"): float(p.find("ssv:Real", ns).get("value")) for p in comp.iter(f"{{{SSV}}}Parameter")}
+        assert bound == start and bound  # rho, g, added mass …
+        kinds = {c.get("name"): c.get("kind") for c in comp.iter(f"{{{SSD}}}Connector")}
+        assert all(kinds[p] == "parameter" for p in bound)
+    assert "rho" in bound or any("added_mass" in p for p in bound)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_ssp_runs_in_fmpy(name, scenes):
+    """fmpy's SSP simulator runs the .ssp.  Its master starts every connector at 0 (no
+    initial exchange) and records each row after the step, so its numbers are compared
+    with a Jacobi loop of the same convention written here over the manifest."""
+    from fmpy.ssp.simulation import simulate_ssp
+    folder = scenes[name]
+    manifest = json.loads((folder / "manifest.json").read_text())
+    step = manifest["run"]["step"]
+    theirs = simulate_ssp(str(folder / f"{name}.ssp"), stop_time=10 * step, step_size=step)
+    assert len(theirs) in (10, 11)  # fmpy accumulates time += step: a last step may follow
+    ours = zero_start_jacobi(folder, manifest, len(theirs), step)
+    for column, values in ours.items():
+        np.testing.assert_allclose(theirs[column], values, rtol=1e-12, atol=1e-12, err_msg=column)
+
+
+def zero_start_jacobi(folder, manifest, steps, step):
+    """Every connected output after each step, with every connected input 0 at the first
+    step and each step's inputs the outputs of the step before (fmpy's SSP convention)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    fmus, vrs = {}, {}
+    for name, inst in manifest["instances"].items():
+        path = str(folder / inst["fmu"])
+        md = read_model_description(path)
+        s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName=name)
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        fmus[name], vrs[name] = s, {v.name: v.valueReference for v in md.modelVariables}
+    conns = manifest["connections"]
+    value = {(d, dv): 0.0 for _, _, d, dv in conns}
+    out = {f"{s}.{sv}": [] for s, sv, _, _ in conns}
+    for k in range(steps):
+        got = {}
+        for name, s in fmus.items():
+            ins = [(dv, value[d, dv]) for _, _, d, dv in conns if d == name]
+            s.setReal([vrs[name][v] for v, _ in ins], [x for _, x in ins])
+            s.doStep(k * step, step)
+            for src, sv, _, _ in conns:
+                if src == name:
+                    got[src, sv] = s.getReal([vrs[name][sv]])[0]
+        for src, sv, d, dv in conns:
+            value[d, dv] = got[src, sv]
+        for (src, sv), v in got.items():
+            out[f"{src}.{sv}"].append(v)
+    for s in fmus.values():
+        s.terminate()
+        s.freeInstance()
+    return out
 
 
 # -- the generic FMI host -----------------------------------------------------------------

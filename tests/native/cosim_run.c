@@ -3,9 +3,10 @@
  *
  *   cosim_run CONFIG STOP STEP OUTDIR
  *
- * CONFIG is an OspSystemStructure.xml or a .ssp file (run with libcosim's fixed-step
- * algorithm at STEP seconds); STOP in seconds; libcosim's file observer writes one CSV
- * per simulator into OUTDIR.  Exit 0 on success, else 1 with libcosim's error printed.
+ * CONFIG is an OspSystemStructure.xml or a .ssp file (libcosim's SSP loader; its
+ * algorithm and step come from the file); STOP in seconds; STEP, in seconds, is the
+ * fixed-step algorithm's step for an .ssp and must be 0 to take the file's; libcosim's
+ * file observer writes one CSV per simulator into OUTDIR.  Exit 0 on success, else 1 with libcosim's error printed.
  * Declarations from libcosimc's cosim.h, written out so that only the library is needed.
  */
 #include <stdbool.h>
@@ -17,6 +18,7 @@
 typedef struct cosim_execution_s cosim_execution;
 typedef struct cosim_observer_s cosim_observer;
 cosim_execution *cosim_osp_config_execution_create(const char *path, bool start_defined, int64_t start);
+cosim_execution *cosim_ssp_execution_create(const char *path, bool start_defined, int64_t start);
 cosim_execution *cosim_ssp_fixed_step_execution_create(const char *path, bool start_defined, int64_t start,
                                                       int64_t step);
 cosim_observer *cosim_file_observer_create(const char *dir);
@@ -44,8 +46,9 @@ int main(int argc, char **argv) {
     cosim_log_set_output_level(4); /* warnings and errors */
     size_t n = strlen(config);
     int ssp = n > 4 && strcmp(config + n - 4, ".ssp") == 0;
-    cosim_execution *ex = ssp ? cosim_ssp_fixed_step_execution_create(config, true, 0, step)
-                              : cosim_osp_config_execution_create(config, true, 0);
+    cosim_execution *ex = !ssp ? cosim_osp_config_execution_create(config, true, 0)
+                          : step ? cosim_ssp_fixed_step_execution_create(config, true, 0, step)
+                                 : cosim_ssp_execution_create(config, true, 0);
     if (!ex) return fail("create");
     cosim_observer *obs = cosim_file_observer_create(argv[4]);
     if (!obs || cosim_execution_add_observer(ex, obs) < 0) return fail("file observer");

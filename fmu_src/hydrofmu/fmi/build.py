@@ -1,6 +1,7 @@
 """Build the FMUs of a scene: one load FMU per floating body, holding only the effects the
 scene gives it, plus one dynamics-partner FMU per body; a manifest (instances,
-connections, run settings) for our masters and an OspSystemStructure.xml for libcosim.
+connections, run settings) for our masters, an OspSystemStructure.xml for libcosim and an
+SSP file (``<scene>.ssp``, fmi/ssp.py) for any SSP importer.
 
 Each FMU is self-contained: its resources carry a copy of the hydrofmu runtime under a
 content-hashed name (two FMUs of different builds in one process never share code by
@@ -22,6 +23,7 @@ from xml.dom import minidom
 import numpy as np
 
 from . import model_description
+from .ssp import write_ssp
 from .slave import CONFIG
 from ..physics import joint as conb
 from ..physics.kinematics import rotation
@@ -401,6 +403,9 @@ def build_scene(scene, outdir, shim=True, log=print):
         }
         (result / "manifest.json").write_text(json.dumps(manifest, indent=2))
         (result / "OspSystemStructure.xml").write_text(osp_system_structure(scene, specs, conns))
+        write_ssp(result / f"{scene.name}.ssp", scene.name,
+                  {s["instance"]: result / f"{s['model_id']}.fmu" for s in specs}, conns,
+                  scene.run["stop"], scene.run["step"])
         old = outdir / f".{scene.name}.old"
         if target.exists():
             shutil.rmtree(old, ignore_errors=True)

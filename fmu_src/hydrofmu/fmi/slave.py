@@ -463,9 +463,13 @@ class FeedthroughMemory:
         return self.ev.peek(self.pending, v)
 
     def commit(self, v, dt_next):
-        """Close the pending interval at velocity v; the next one is dt_next long."""
+        """Close the pending interval at velocity v; the next one is dt_next long.  At the
+        first step v is the velocity at t0: an input set after initialization and before the
+        first fmi2DoStep is the value at t0 (FMI 2.0), so it starts the history."""
         if self.pending > 0.0:
             self.ev.advance(self.pending, v)
+        else:
+            self.ev.restart(v)
         self.pending = float(dt_next)
 
     def state(self):

@@ -110,6 +110,11 @@ class Convolution:
         """Velocity at the current time."""
         return self._v[self._hi - 1].copy()
 
+    def restart(self, v0):
+        """Set the velocity at the start: the history's first node (before any ``advance``)."""
+        self._v[self._hi - 1] = _start(self.shape, v0)
+        self._peeked = None
+
     @property
     def nodes(self):
         """Number of velocity breakpoints held (bounded by span / smallest dt + 2)."""
@@ -413,6 +418,11 @@ class StateSpace:
     @property
     def velocity(self):
         return self._v.copy()
+
+    def restart(self, v0):
+        """Set the velocity at the start (before any ``advance``; the states are still zero)."""
+        self._v = _start(self.shape, v0)
+        self._peeked = None
 
     def _discrete(self, dt):
         """(e^{μdt}, B) for a step dt: z_new = e·z + B·[v_old; v_new], with B (real view,
