@@ -171,7 +171,7 @@ static int inner_path(char *out, size_t size) {
 #define MINIMUM_PYTHON "3.10"
 #define MINIMUM_PYTHON_TUPLE "3, 10"
 #define HOWTO "Set HYDROFMU_PYTHON to a Python >= " MINIMUM_PYTHON " interpreter (or venv python) " \
-    "that has numpy and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
+    "that has numpy and scipy and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
 
 /* Run in the new interpreter: sys._hydrofmu_check = '' when usable, else why not. */
 static const char CHECK[] =
@@ -249,9 +249,9 @@ static int asked_interpreter(Interpreter *py, const char *exe) {
     snprintf(py->exe, sizeof py->exe, "%s", exe);
     snprintf(py->origin, sizeof py->origin, "from HYDROFMU_PYTHON=%s", exe);
     /* single-quote the path for the shell: ' becomes '\'' */
-    char cmd[8192 + sizeof QUERY * 2], *q = cmd;
+    char cmd[4 * sizeof py->exe + 2 * sizeof QUERY + 64], *q = cmd; /* room for the worst escaping */
     q += sprintf(q, "'");
-    for (const char *p = exe; *p && q < cmd + 8192; p++) q += *p == '\'' ? sprintf(q, "'\\''") : sprintf(q, "%c", *p);
+    for (const char *p = py->exe; *p; p++) q += *p == '\'' ? sprintf(q, "'\\''") : sprintf(q, "%c", *p);
     q += sprintf(q, "' -I -S -c \"");
     for (const char *p = QUERY; *p; p++) {
         if (*p == '"' || *p == '\\' || *p == '$' || *p == '`') *q++ = '\\';
