@@ -74,3 +74,43 @@ def test_per_call_interleaves_and_restarts():
                     "b": lambda: (lambda k: calls.append(("b", k)))}, calls=2, rounds=2)
     assert calls == [("a", 0), ("a", 1), ("b", 0), ("b", 1)] * 2
     assert set(res) == {"a", "b"} and all(v >= 0 for v in res.values())
+
+
+def test_floor_fmu_copies_its_inputs(tmp_path):
+    """The floor FMU built on the fly does what it claims: after a step y = u; the floor
+    system chains n of them in a ring (y of f_k feeds u of f_k+1) that the master runs."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from hydrofmu.bench import floor
+
+    fmu = floor.build_floor(tmp_path)
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="f")
+    slave.instantiate()
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        u = [1.5, -2.0, 3.25, 0.0, 7.0, -0.5]
+        slave.setReal([vr[f"u[{i}]"] for i in range(1, 7)], u)
+        assert slave.getReal([vr[f"y[{i}]"] for i in range(1, 7)]) == [0.0] * 6   # not before the step
+        slave.doStep(0.0, 0.05)
+        assert slave.getReal([vr[f"y[{i}]"] for i in range(1, 7)]) == u
+    finally:
+        slave.terminate()
+        slave.freeInstance()
+    folder = floor.floor_system(tmp_path, fmu, 3)
+    assert floor.fmu_count(folder) == 3
+    assert floor.per_step(folder, 20, 0.05) > 0 and floor.startup(folder) > 0
+
+
+def test_floor_spread_and_linearity_bookkeeping():
+    from hydrofmu.bench import floor
+    assert floor.spread([1.0, 1.2, 0.9]) == pytest.approx(0.3)
+    rows = [{"step_us": 100.0}, {"step_us": 160.0}, {"step_us": 400.0}]
+    marginal, ratio = floor.linearity(rows, [3, 10, 36])
+    assert marginal == pytest.approx([60 / 7, 240 / 26])
+    assert ratio == pytest.approx((240 / 26) / (60 / 7))

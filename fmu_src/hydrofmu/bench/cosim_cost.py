@@ -1,5 +1,5 @@
-"""Whole co-simulations through fmpy: communication step against accuracy, cost against
-the number of coupled bodies, and cost per step along simulated time.
+"""Whole co-simulations through fmpy: communication step against accuracy and cost per step
+along simulated time (cost against the number of coupled bodies: ``floor``).
 
 All runs use ``fleet.Fleet`` (bodies coupled by SIMO interaction) in export mode; the
 error is the largest normalised RMS (``fleet.nrms``) over the moving translations against
@@ -61,21 +61,6 @@ def _per_step(built, stop, step, chunks=1):
     run(built, stop=stop, step=step, progress=False, record=[],
         on_step=lambda k: marks.append(time.perf_counter()) if k % every == 0 else None)
     return np.diff(marks) / every
-
-
-def body_growth(folder, counts=(2, 4, 8), stop=20.0, step=0.05, preset="design"):
-    """Rows {bodies, couplings, fmus, ms_per_step}: every pair of bodies coupled (all-pairs
-    interaction, so couplings grow as n(n+1)/2), one load FMU per body and one coupled
-    dynamics FMU."""
-    rows = []
-    for n in counts:
-        fleet = Fleet(n)
-        built = _build(fleet.scene(Path(folder) / f"n{n}", run=f'preset = "{preset}"\nstop = {stop}',
-                                   name=f"fleet{n}"), Path(folder) / f"n{n}" / "fmus")
-        cost = _per_step(built, stop, step)[0]
-        rows.append({"bodies": n, "couplings": len(fleet.pairs()), "fmus": len(list(built.glob("*.fmu"))),
-                     "ms_per_step": 1e3 * cost})
-    return rows
 
 
 def flatness(folder, stop=1000.0, step=0.05, chunks=10, method="convolution"):

@@ -5,7 +5,9 @@ Parts (each also callable alone, see ``PARTS``):
 - overhead: load FMU through fmpy against its kernels in-process (``overhead``)
 - memory: evaluator cost against force error at 2000 lags (``memory_cost.tradeoff``)
 - sweep: communication step × algorithm × load hold on the two-body scene (``cosim_cost``)
-- growth: cost against kernel length, number of coupled bodies, simulated time
+- growth: cost against kernel length and simulated time
+- floor: startup and cost per step of every scene of models/ and of 2, 4, 8 coupled bodies,
+  as multiples of the pythonfmu floor (``floor``), with the targets and a noise verdict
 - stability: added-mass stability map, explicit against export (``stability``)
 
 ``quick`` shrinks every part (for a smoke run); the figures in the README come from a full run.
@@ -19,7 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from . import cosim_cost, memory_cost, overhead, stability  # noqa: E402
+from . import cosim_cost, floor, memory_cost, overhead, stability  # noqa: E402
 
 
 def write_csv(path, rows):
@@ -98,20 +100,15 @@ def part_sweep(out, quick):
 def part_growth(out, quick):
     lags = memory_cost.growth((100, 1000) if quick else (100, 300, 1000, 3000, 10000),
                               calls=100 if quick else 300, rounds=3 if quick else 5)
-    bodies = cosim_cost.body_growth(out / "bodies", (2, 4) if quick else (2, 4, 8), stop=5.0 if quick else 20.0)
     flat = cosim_cost.flatness(out / "flat", stop=100.0 if quick else 1000.0, chunks=5 if quick else 10)
     write_csv(out / "growth_lags.csv", lags)
-    write_csv(out / "growth_bodies.csv", bodies)
     write_csv(out / "growth_time.csv", flat)
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4.5))
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4.5))
     ax[0].loglog([r["lags"] for r in lags], [r["convolution_us"] for r in lags], "s-", label="convolution")
     ax[0].loglog([r["lags"] for r in lags], [r["state_space_us"] for r in lags], "o-", label="state-space (1 %)")
     ax[0].set(xlabel="kernel length [lags]", ylabel="cost per step [µs]", title="6×6 memory")
-    ax[1].plot([r["bodies"] for r in bodies], [r["ms_per_step"] for r in bodies], "o-")
-    ax[1].set(xlabel="coupled bodies (all pairs)", ylabel="co-simulation cost per step [ms]",
-              title="design preset, fmpy")
-    ax[2].plot([0.5 * (r["t_start"] + r["t_end"]) for r in flat], [r["us_per_step"] for r in flat], "o-")
-    ax[2].set(xlabel="simulated time [s]", ylabel="cost per step [µs]", title="two bodies, convolution",
+    ax[1].plot([0.5 * (r["t_start"] + r["t_end"]) for r in flat], [r["us_per_step"] for r in flat], "o-")
+    ax[1].set(xlabel="simulated time [s]", ylabel="cost per step [µs]", title="two bodies, convolution",
               ylim=(0, 1.3 * max(r["us_per_step"] for r in flat)))
     for a in ax:
         a.grid(True, which="both", alpha=0.3)
@@ -122,8 +119,54 @@ def part_growth(out, quick):
     late = [r["us_per_step"] for r in flat if r["t_start"] >= 60.0]
     return [f"kernel {lags[0]['lags']} → {lags[-1]['lags']} lags: convolution ×{lags[-1]['convolution_us'] / lags[0]['convolution_us']:.1f}, "
             f"state-space ×{lags[-1]['state_space_us'] / lags[0]['state_space_us']:.2f}",
-            f"bodies {bodies[0]['bodies']} → {bodies[-1]['bodies']}: cost per step ×{bodies[-1]['ms_per_step'] / bodies[0]['ms_per_step']:.1f}",
             f"cost per step after the memory fills: last/first = {late[-1] / late[0]:.2f}" if len(late) > 1 else ""]
+
+
+def part_floor(out, quick):
+    """Every scene of models/ and 2, 4, 8 coupled bodies against the pythonfmu floor."""
+    from ..fmi.build import build_scene
+    from ..scene import load_scene
+    from .fleet import Fleet
+    quiet = lambda *_: None
+    fmu = floor.build_floor(out / "floor")
+    candidates = {}
+    for path in sorted(Path("models").glob("*.toml")):
+        scene = load_scene(path)
+        candidates[scene.name] = build_scene(scene, out / "floor" / "scenes", log=quiet)
+    counts = (2, 4) if quick else (2, 4, 8)
+    pairs = []
+    for n in counts:
+        fleet = Fleet(n)
+        path = fleet.scene(out / "floor" / f"bodies{n}", run='preset = "design"', name=f"bodies{n}")
+        candidates[f"{n} bodies"] = build_scene(load_scene(path), out / "floor" / f"bodies{n}" / "fmus", log=quiet)
+        pairs.append(len(fleet.pairs()))
+    rows = floor.compare(candidates, fmu, out / "floor", rounds=3 if quick else 5, steps=100 if quick else 400)
+    write_csv(out / "floor.csv", rows)
+    noisy = [r["label"] for r in rows if r["noisy"]]
+    lines = [f"floor: {r['fmus']} trivial pythonfmu FMUs {r['step_floor_us']:.0f} µs per step, "
+             f"startup {1e3 * r['startup_floor_s']:.0f} ms" for r in {r["fmus"]: r for r in rows}.values()]
+    for r in rows:
+        if r["noisy"]:
+            lines.append(f"{r['label']}: too noisy (spread between rounds {100 * r['spread']:.0f} % > "
+                         f"{100 * floor.NOISY:.0f} %), no figure")
+            continue
+        lines.append(f"{r['label']} ({r['fmus']} FMUs): {r['step_x']:.1f}× the floor per step "
+                     f"({r['step_us']:.0f} µs), {r['startup_x']:.1f}× at startup ({1e3 * r['startup_s']:.0f} ms)")
+    design = next((r for r in rows if r["label"] == "side_by_side"), None)
+    if design is not None and not design["noisy"]:
+        met = lambda x: "met" if x <= 5.0 else "NOT met"
+        lines.append(f"target side_by_side ≤ 5× per step: {met(design['step_x'])} ({design['step_x']:.1f}×); "
+                     f"≤ 5× at startup: {met(design['startup_x'])} ({design['startup_x']:.1f}×)")
+    bodies = [r for r in rows if r["label"].endswith(" bodies")]
+    if len(bodies) > 1 and not any(r["noisy"] for r in bodies):
+        marginal, ratio = floor.linearity(bodies, pairs)
+        lines.append(f"bodies {' → '.join(str(n) for n in counts)} ({' → '.join(map(str, pairs))} coupled pairs): "
+                     + " → ".join(f"{r['step_us']:.0f}" for r in bodies) + " µs per step; marginal cost per pair "
+                     + " → ".join(f"{m:.0f}" for m in marginal) + " µs"
+                     + (f" (last/first {ratio:.2f}; 1 = linear in the pairs)" if len(marginal) > 1 else ""))
+    elif noisy:
+        lines.append(f"too noisy for the body-count trend ({', '.join(noisy)})")
+    return lines
 
 
 def part_stability(out, quick):
@@ -132,7 +175,7 @@ def part_stability(out, quick):
 
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
-         "stability": part_stability}
+         "floor": part_floor, "stability": part_stability}
 
 
 def main(out, parts=None, quick=False, log=print):

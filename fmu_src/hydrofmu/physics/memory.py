@@ -25,7 +25,6 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 
 
 def _elements(kernels, shape=None):
@@ -197,6 +196,7 @@ class Convolution:
         cols = np.concatenate([j, j + hl.shape[0], j, j + hl.shape[0]])
         data = np.concatenate([(1 - aa) * na + (1 - ab) * nb, aa * na + ab * nb,
                                (1 - aa) * fa + (1 - ab) * fb, aa * fa + ab * fb])
+        from scipy import sparse   # here, not at import: FMUs with state-space memory never need it
         m = sparse.csr_matrix((data, (rows, cols)), shape=(s.size, 2 * hl.shape[0]))
         return m @ self._h2
 

@@ -1,0 +1,154 @@
+"""FMU figures against the pythonfmu floor: startup and cost per step of whole scenes.
+
+The floor is what an FMU built with pythonfmu cannot beat: a trivial pythonfmu FMU (6 inputs,
+6 outputs, ``do_step`` copies the inputs to the outputs), built on the fly.  For a scene of
+n FMUs, the floor is n of them connected in a ring and run by the same master
+(``cosim.master``, Gauss–Seidel, every output recorded), so every figure below is a multiple
+of what the same master pays for the same number of FMUs that do nothing:
+
+- startup: load, instantiate and initialise every FMU (``master.System`` + ``initialize``)
+  in a fresh Python process that has imported fmpy and numpy (a host's first FMU pays the
+  runtime's imports, as it would);
+- cost per step: the stepping loop of ``master.run`` (startup excluded).
+
+Each candidate is timed right after its floor, in ``rounds`` rounds (floor, scene, floor,
+scene, …); each multiple is the median of the rounds' ratios, and a multiple whose spread
+between rounds, (max − min)/median, is above ``NOISY`` is reported as too noisy instead of
+as a number.
+"""
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+NOISY = 0.25   # spread between rounds above which a figure is not trusted
+
+FLOOR_SCRIPT = '''"""The pythonfmu floor: 6 inputs copied to 6 outputs at every step."""
+from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+
+
+class hydrofmu_floor(Fmi2Slave):
+    author = "hydrofmu bench"
+    description = "trivial FMU: do_step copies u to y"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.u, self.y = [0.0] * 6, [0.0] * 6
+        for i in range(6):
+            self.register_variable(Real(f"u[{i + 1}]", causality=Fmi2Causality.input,
+                                        getter=lambda i=i: self.u[i],
+                                        setter=lambda v, i=i: self.u.__setitem__(i, v)))
+            self.register_variable(Real(f"y[{i + 1}]", causality=Fmi2Causality.output,
+                                        getter=lambda i=i: self.y[i]))
+
+    def do_step(self, current_time, step_size):
+        self.y[:] = self.u
+        return True
+'''
+
+STARTUP = '''import json, sys, time
+import numpy, fmpy
+from hydrofmu.cosim.master import System
+t0 = time.perf_counter()
+system = System(sys.argv[1])
+system.initialize()
+t1 = time.perf_counter()
+system.free()
+print(json.dumps(t1 - t0))
+'''
+
+
+def build_floor(folder):
+    """Build the trivial FMU into ``folder``; returns its path."""
+    from pythonfmu.builder import FmuBuilder
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        script = Path(tmp) / "hydrofmu_floor.py"
+        script.write_text(FLOOR_SCRIPT)
+        saved = list(sys.path)
+        try:
+            return Path(FmuBuilder.build_FMU(script, dest=folder))
+        finally:
+            sys.path[:] = saved
+
+
+def floor_system(folder, fmu, n, step=0.05):
+    """A run folder (manifest.json for ``cosim.master``) of n floor FMUs in a ring: y of
+    instance k feeds u of instance k + 1."""
+    folder = Path(folder) / f"floor{n}"
+    folder.mkdir(parents=True, exist_ok=True)
+    names = [f"f{k}" for k in range(n)]
+    conns = [[a, f"y[{i}]", b, f"u[{i}]"] for a, b in zip(names, names[1:] + names[:1]) for i in range(1, 7)]
+    manifest = {"scene": f"floor{n}", "order": names, "connections": conns, "dynamics": {},
+                "instances": {k: {"fmu": str(Path(fmu).resolve()), "kind": "floor", "body": ""} for k in names},
+                "run": {"step": step, "stop": 1.0, "algorithm": "gauss-seidel", "preset": None,
+                        "substep": step, "load_hold": "constant", "set": []}}
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    return folder
+
+
+def fmu_count(folder):
+    return len(json.loads((Path(folder) / "manifest.json").read_text())["order"])
+
+
+def startup(folder):
+    """Seconds to load, instantiate and initialise every FMU of a run folder, in a fresh process."""
+    out = subprocess.run([sys.executable, "-c", STARTUP, str(folder)], capture_output=True, text=True, check=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def per_step(folder, steps, step):
+    """Seconds per communication step of ``master.run`` (its stepping loop only)."""
+    from ..cosim.master import run
+    marks = {}
+
+    def mark(k):
+        if k in (1, steps):
+            marks[k] = time.perf_counter()
+    run(folder, stop=steps * step, step=step, progress=False, on_step=mark)
+    return (marks[steps] - marks[1]) / (steps - 1)
+
+
+def spread(values):
+    """(max − min)/median of the rounds of one figure."""
+    v = np.asarray(values, float)
+    return float((v.max() - v.min()) / np.median(v))
+
+
+def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05):
+    """Startup and cost per step of each run folder in ``candidates`` ({label: folder})
+    against n floor FMUs (n = its FMU count), measured back to back in each of ``rounds``
+    rounds, so that a slow spell of the machine hits both.  Rows {label, fmus, startup_s,
+    startup_floor_s, startup_x, step_us, step_floor_us, step_x (medians over the rounds;
+    the multiples are medians of each round's ratio), spread: the larger relative spread
+    of the two multiples between rounds, noisy: spread > NOISY}."""
+    floors = {n: floor_system(out, floor_fmu, n, step) for n in sorted({fmu_count(f) for f in candidates.values()})}
+    got = {label: [] for label in candidates}
+    for _ in range(rounds):
+        for label, folder in candidates.items():
+            fl = floors[fmu_count(folder)]
+            got[label].append((startup(fl), startup(folder), per_step(fl, steps, step), per_step(folder, steps, step)))
+    rows = []
+    for label, folder in candidates.items():
+        t = np.array(got[label])
+        start_x, step_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
+        worst = max(spread(start_x), spread(step_x))
+        rows.append({"label": label, "fmus": fmu_count(folder),
+                     "startup_s": float(np.median(t[:, 1])), "startup_floor_s": float(np.median(t[:, 0])),
+                     "startup_x": float(np.median(start_x)),
+                     "step_us": 1e6 * float(np.median(t[:, 3])), "step_floor_us": 1e6 * float(np.median(t[:, 2])),
+                     "step_x": float(np.median(step_x)), "spread": worst, "noisy": worst > NOISY})
+    return rows
+
+
+def linearity(rows, pairs):
+    """Marginal cost per coupled pair between consecutive body counts [µs per pair] and
+    the ratio last/first (1: the cost per step is linear in the pairs)."""
+    c = [r["step_us"] for r in rows]
+    marginal = [(c[k + 1] - c[k]) / (pairs[k + 1] - pairs[k]) for k in range(len(c) - 1)]
+    return marginal, marginal[-1] / marginal[0] if len(marginal) > 1 and marginal[0] > 0 else float("nan")
