@@ -70,6 +70,11 @@ import numpy as np
 from ..errors import InputError
 from .state import Motion
 
+try:   # the gufunc behind np.linalg.solve, without its ~4 µs of wrapping per call
+    from numpy.linalg._umath_linalg import solve1 as _solve
+except ImportError:  # pragma: no cover - other numpy layouts
+    _solve = np.linalg.solve
+
 GIMBAL_TOL = 1e-6  # |cos θ| below which the Euler-angle rates are declared singular
 
 # Butcher's 7-stage Runge–Kutta method of order 6: nodes c, weights b, coefficients a.
@@ -172,21 +177,26 @@ class _Equations:
         rhs -= bias
         return big, rhs, kin
 
-    def accelerations(self, y, load, signs=None):
-        big, rhs, _ = self.system(y, load, signs)
-        try:
+    def solve(self, big, rhs):
+        """(M_rb + A)⁻¹·rhs; a singular mass matrix is an InputError."""
+        with np.errstate(all="ignore"):
+            acc = _solve(big, rhs)
+        if math.isfinite(acc.sum()):
+            return acc
+        try:   # not finite: np.linalg.solve tells a singular matrix from a non-finite input
             return np.linalg.solve(big, rhs)
         except np.linalg.LinAlgError:
             raise self.first._error("added_mass", "mass matrix M_rb + A is singular") from None
+
+    def accelerations(self, y, load, signs=None):
+        big, rhs, _ = self.system(y, load, signs)
+        return self.solve(big, rhs)
 
     def deriv(self, y, load, signs):
         big, rhs, kin = self.system(y, load, signs)
         out = np.empty(y.size)
         out[self.kin_idx] = kin
-        try:
-            out[self.acc_idx] = np.linalg.solve(big, rhs)
-        except np.linalg.LinAlgError:
-            raise self.first._error("added_mass", "mass matrix M_rb + A is singular") from None
+        out[self.acc_idx] = self.solve(big, rhs)
         return out
 
     def integrate(self, y, load, rate, dt, max_substep):
@@ -194,13 +204,15 @@ class _Equations:
         n = max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))  # 1e-12: round-off
         h = dt / n
         signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in y[4::12].tolist()]
-        k = np.empty((7, y.size))
+        k = np.zeros((7, y.size))    # rows past a stage meet zeros of RK_A: never garbage
+        ha, hb = h * RK_A, h * RK_B
         f = self.deriv
         for m in range(n):
-            for s in range(7):
-                ys = y if s == 0 else y + h * (RK_A[s, :s] @ k[:s])
-                k[s] = f(ys, load if rate is None else load + rate * ((m + RK_C[s]) * h), signs)
-            y = y + h * (RK_B @ k)
+            loads = [load] * 7 if rate is None else load + np.outer((m + RK_C) * h, rate)
+            k[0] = f(y, loads[0], signs)
+            for s in range(1, 7):
+                k[s] = f(y + ha[s] @ k, loads[s], signs)
+            y = y + hb @ k
         for i, ct in enumerate(np.cos(y[4::12]).tolist()):
             if abs(ct) < GIMBAL_TOL:
                 raise GimbalLockError(_gimbal_message(y[12 * i + 3:12 * i + 6]))
