@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | validate | demo | bench | bem2simo`` (a thin layer over the library)."""
+"""Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer over the library)."""
 import argparse
 import json
 import sys
@@ -78,6 +78,26 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
     return made
 
 
+def batch(args):
+    """``hydrofmu batch``: exit 0 when every case ran, 1 when some failed."""
+    try:
+        from .batch import run_batch
+        import distributed, pandas, pyarrow  # noqa: F401  (the batch extra)
+    except ImportError as exc:
+        print(f"error: hydrofmu batch needs the batch extra (pip install 'hydrofmu[batch]'): {exc}", file=sys.stderr)
+        return 2
+    out = args.out or Path("build") / "batch" / args.cases.stem
+    table = run_batch(args.cases, out, workers=args.workers, scheduler=args.scheduler,
+                      series=True if args.series else None, retry_failed=args.retry_failed)
+    counts = table["status"].value_counts().to_dict()
+    wrote = ", ".join(str(out / f) for f in ("cases.csv", "cases.parquet", "cases.png") if (out / f).exists())
+    print(f"batch: {len(table)} cases, " + ", ".join(f"{n} {s}" for s, n in sorted(counts.items()))
+          + f"; wrote {wrote}")
+    for _, row in table[table["status"] != "ok"].head(10).iterrows():
+        print(f"  case {row['case']}: {row['status']}: {row['error']}")
+    return 0 if counts.get("ok", 0) == len(table) else 1
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="hydrofmu", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -93,6 +113,15 @@ def main(argv=None):
     r.add_argument("--stop", type=float)
     r.add_argument("--csv", type=Path)
     r.add_argument("--png", type=Path)
+    a = sub.add_parser("batch", help="run a matrix of load cases (a case file) on Dask: one table, plots")
+    a.add_argument("cases", type=Path, help="case file (TOML, see the README's 'Load-case batches')")
+    a.add_argument("-o", "--out", type=Path, help="results folder (default build/batch/<case file name>)")
+    where = a.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="worker processes of the local Dask cluster (default: cores)")
+    where.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 "
+                                           "(the FMUs are shipped to its workers)")
+    a.add_argument("--series", action="store_true", help="write each case's time series (DIR/series/<case>.parquet)")
+    a.add_argument("--retry-failed", action="store_true", help="rerun the cases that failed in an earlier run")
     v = sub.add_parser("validate", help="fmpy validation of built FMUs")
     v.add_argument("paths", nargs="*", default=[str(DEFAULT_OUT)])
     d = sub.add_parser("demo", help="build every scene in models/, run each one, write CSV and PNG per scene")
@@ -126,6 +155,8 @@ def main(argv=None):
             result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
                                 algorithm=args.algorithm)
             print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)})")
+        elif args.command == "batch":
+            return batch(args)
         elif args.command == "demo":
             folders = build(scenes_in([]), args.out)
             for name in args.scene or folders:

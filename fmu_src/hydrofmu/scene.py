@@ -594,9 +594,10 @@ def _body(problems, name, table, where):
     return body
 
 
-def load_scene(path):
+def load_scene(path, overrides=None):
     """Read and validate a scene file.  Raises one InputError naming the file and the
-    key path of every problem; returns a Scene whose effect data is ready for kernels."""
+    key path of every problem; returns a Scene whose effect data is ready for kernels.
+    ``overrides``: {key path: value} replacing values of the file (``override``)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -607,6 +608,8 @@ def load_scene(path):
     except tomllib.TOMLDecodeError as exc:
         line = getattr(exc, "lineno", None)
         raise InputError(path, line, "toml", str(exc)) from None
+    for key, value in (overrides or {}).items():
+        override(doc, key, value, path)
     p = Problems(path)
     p.known_keys(doc, "", {"scene", "environment", "run", "bodies", "joints", "couplings"})
     meta = p.table(doc, "scene", "scene", required=False) or {}
@@ -663,3 +666,32 @@ def load_scene(path):
     )
     p.raise_if_any()
     return scene
+
+
+SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
+
+
+def override(doc, key, value, path="scene"):
+    """Set the value at a scene key path (``run.preset``, ``bodies.barge.velocity``,
+    ``couplings[0].method``) in a parsed scene ``doc``, as if the file held it.  A missing
+    top-level table is created; every other table or array on the way must exist."""
+    import re
+    parts = [(m.group(1), m.group(2)) for m in re.finditer(r"([^.\[\]]+)((?:\[\d+\])*)", key)]
+    if not parts or ".".join(n + i for n, i in parts) != key or parts[0][0] not in SECTIONS:
+        raise InputError(path, None, key, f"not a scene key path (it starts with one of {', '.join(SECTIONS)})")
+    node, where = doc, ""
+    steps = [s for name, idx in parts for s in [name] + [int(i) for i in re.findall(r"\d+", idx)]]
+    for i, step in enumerate(steps):
+        last = i == len(steps) - 1
+        if isinstance(step, int):
+            if not isinstance(node, list) or step >= len(node):
+                raise InputError(path, None, key, f"{where} has no element [{step}]")
+        elif not isinstance(node, dict) or (not last and step not in node and i > 0):
+            raise InputError(path, None, key, f"{where or 'the scene'} has no table {step!r}")
+        if last:
+            node[step] = value
+        else:
+            if i == 0 and step not in node:
+                node[step] = {}
+            node = node[step]
+        where = f"{where}[{step}]" if isinstance(step, int) else f"{where}.{step}" if where else step

@@ -15,6 +15,7 @@ initialization mode, so at t = 0 every load output reflects the initial motion.
 """
 import csv
 import ctypes
+import shutil
 import sys
 import time as clock
 from dataclasses import dataclass
@@ -151,6 +152,7 @@ class Instance:
             self.fmu.terminate()
         finally:
             self.fmu.freeInstance()
+            shutil.rmtree(self.dir, ignore_errors=True)  # the extracted copy (batches run thousands)
 
 
 class Port:

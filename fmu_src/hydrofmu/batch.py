@@ -1,0 +1,616 @@
+"""Load-case batches: one scene, a matrix of cases, each case one co-simulation, run on Dask.
+
+A case is a set of knobs (key → value):
+
+- ``environment.current_speed``, ``environment.current_direction``, ``environment.rho``,
+  ``environment.g``: the FMUs expose them (current.speed/direction inputs, rho/g
+  parameters), so a case sets them at initialisation and shares the build;
+- ``instance.variable`` (e.g. ``barge.rho``): any parameter or unconnected input of an FMU;
+- any other scene key path (``run.preset``, ``run.substep``, ``bodies.barge.velocity``,
+  ``couplings[0].method``; ``stop``, ``step``, ``algorithm`` stand for ``run.…``): the scene
+  is read with the override.  Cases whose FMUs come out identical (same typed description)
+  share one build, so ``run.stop`` or ``run.step`` (without default joint springs) do not
+  rebuild; what the build bakes in (substep, load hold, preset, masses…) is built once per
+  distinct variant.
+
+The client builds each variant once, ships its FMUs to the workers as bytes (no shared
+disk needed) and keeps a bounded number of cases in flight.  Each case's result (knobs,
+status, error, wall time, statistics of the named outputs) is written to
+``DIR/cases/<case>.json`` atomically as it finishes; the case id is a hash of everything
+that determines the result (build, parameters, run settings, outputs), so a rerun skips
+finished cases.  The table (``DIR/cases.csv`` and ``.parquet``) is assembled from those
+files at the end.  Needs the ``batch`` extra (Dask distributed, pandas, pyarrow).
+"""
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+import threading
+import time
+import tomllib
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorithm"}
+# scene keys the FMUs expose: key -> FMU variable name (in every FMU that has it)
+EXPOSED = {"environment.current_speed": "current.speed", "environment.current_direction": "current.direction",
+           "environment.rho": "rho", "environment.g": "g"}
+STATS = ("max", "min", "mean", "std", "final")
+FILE_KEYS = {"scene", "outputs", "stop", "step", "algorithm", "transient", "series", "set", "matrix", "cases"}
+SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
+
+
+@dataclass
+class Batch:
+    """A validated case file.  ``scene``: scene file or built scene folder; ``outputs``:
+    'instance.variable' names; ``fixed``: knobs of every case; ``matrix``: key → values
+    (cases are the cross product); ``extra``: single cases after the matrix ones;
+    ``transient`` [s]: statistics leave out t < transient; ``series``: write time series."""
+    path: Path
+    scene: Path
+    outputs: list
+    fixed: dict = field(default_factory=dict)
+    matrix: dict = field(default_factory=dict)
+    extra: list = field(default_factory=list)
+    transient: float = 0.0
+    series: bool = False
+
+    def __len__(self):
+        n = math.prod(len(v) for v in self.matrix.values()) if self.matrix else (0 if self.extra else 1)
+        return n + len(self.extra)
+
+    def cases(self):
+        """Knobs of every case, matrix cases first (lazily: a batch may be large)."""
+        if self.matrix or not self.extra:
+            keys = list(self.matrix)
+            for values in itertools.product(*self.matrix.values()):
+                yield {**self.fixed, **dict(zip(keys, values))}
+        for case in self.extra:
+            yield {**self.fixed, **case}
+
+    @property
+    def keys(self):
+        out = dict.fromkeys(self.fixed)
+        out.update(dict.fromkeys(self.matrix))
+        for case in self.extra:
+            out.update(dict.fromkeys(case))
+        return list(out)
+
+
+def _canonical(key):
+    return RUN_ALIASES.get(key, key)
+
+
+def _knobs(p, table, where):
+    """A table of knobs with canonical keys; values must be numbers, strings, booleans or
+    arrays of numbers (what a scene holds)."""
+    out = {}
+    for key, value in table.items():
+        if not isinstance(key, str) or not key:
+            p.add(f"{where}.{key}", "expected a key path")
+            continue
+        out[_canonical(key)] = value
+    return out
+
+
+def load_cases(source, base=None) -> Batch:
+    """Read and check a case file (path) or the same content as a dict (paths in it relative
+    to ``base``, default the current folder).  Raises one InputError naming every problem."""
+    from .scene import Problems
+    if isinstance(source, dict):
+        path, doc = Path(base or ".") / "<cases>", source
+    else:
+        path = Path(source)
+        try:
+            doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+        except OSError as exc:
+            raise InputError(path, None, "file", f"cannot read case file ({exc.strerror})") from None
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise InputError(path, getattr(exc, "lineno", None), "toml", str(exc)) from None
+    p = Problems(path)
+    p.known_keys(doc, "", FILE_KEYS)
+    name = p.string(doc, "scene", "scene")
+    scene = (path.parent / name).resolve() if name else None
+    if scene is not None and not (scene.is_file() or (scene / "manifest.json").is_file()):
+        p.add("scene", f"no scene file or built scene folder (manifest.json) at {scene}")
+    outputs = doc.get("outputs")
+    if (not isinstance(outputs, list) or not outputs
+            or not all(isinstance(o, str) and "." in o for o in outputs)):
+        p.add("outputs", "expected a non-empty array of 'instance.variable' names")
+        outputs = []
+    fixed = {}
+    for key in ("stop", "step"):
+        if key in doc and p.number(doc, key, key, positive=True) is not None:
+            fixed[f"run.{key}"] = float(doc[key])
+    if "algorithm" in doc and p.choice(doc, "algorithm", "algorithm", ("jacobi", "gauss-seidel")):
+        fixed["run.algorithm"] = doc["algorithm"]
+    transient = p.number(doc, "transient", "transient", 0.0, nonneg=True)
+    series = doc.get("series", False)
+    if not isinstance(series, bool):
+        p.add("series", f"expected true or false, found {series!r}")
+    fixed.update(_knobs(p, p.table(doc, "set", "set", required=False) or {}, "set"))
+    matrix = {}
+    for key, values in _knobs(p, p.table(doc, "matrix", "matrix", required=False) or {}, "matrix").items():
+        values = values if isinstance(values, list) else [values]
+        if not values:
+            p.add(f"matrix.{key}", "expected at least one value")
+        matrix[key] = values
+    extra = doc.get("cases", [])
+    if not isinstance(extra, list) or not all(isinstance(c, dict) for c in extra):
+        p.add("cases", "expected an array of tables ([[cases]])")
+        extra = []
+    extra = [_knobs(p, c, f"cases[{i}]") for i, c in enumerate(extra)]
+    batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True)
+    built = scene is not None and scene.is_dir()
+    for key in batch.keys:
+        first = key.split(".", 1)[0].split("[", 1)[0]
+        if first in SCENE_SECTIONS and built and key not in EXPOSED and not key.startswith("run."):
+            p.add(key, "the build bakes this in: name the scene file, not a built folder")
+        elif first not in SCENE_SECTIONS and "." not in key:
+            p.add(key, f"expected a scene key path ({', '.join(SCENE_SECTIONS)}…), 'instance.variable', "
+                       "or stop/step/algorithm")
+    p.raise_if_any()
+    return batch
+
+
+# --- variants: one build per distinct set of FMUs -------------------------------------
+
+def _digest(obj):
+    return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+@dataclass
+class Variant:
+    """A build shared by cases: ``id`` (hash of its FMU descriptions and runtime), its
+    ``folder``, run settings of the scene read with the case's overrides, the FMU
+    variables a case may set (name → causality) or the ``error`` that stops its cases."""
+    id: str = None
+    folder: Path = None
+    run: dict = None
+    variables: dict = None
+    error: str = None
+    blob: object = None   # the scattered FMU bytes (a Dask future), on the shared build
+
+
+class Variants:
+    """Scene variants of a batch, read and built on first use, each built once."""
+
+    def __init__(self, batch, out, log):
+        from .fmi.build import runtime_name
+        self.batch, self.out, self.log = batch, Path(out), log
+        self.runtime = runtime_name()
+        self.groups = {}      # scene overrides (json) -> Variant
+        self.builds = {}      # variant id -> Variant
+        self.checked = {}     # (exposed key, value) -> error or None
+
+    def scene(self, overrides):
+        from .scene import load_scene
+        return load_scene(self.batch.scene, overrides)
+
+    def get(self, overrides) -> Variant:
+        key = json.dumps(overrides, sort_keys=True, default=str)
+        if key not in self.groups:
+            self.groups[key] = self._make(overrides)
+        return self.groups[key]
+
+    def _make(self, overrides):
+        if self.batch.scene.is_dir():
+            folder = self.batch.scene
+            manifest = json.loads((folder / "manifest.json").read_text())
+            files = sorted(str(f.relative_to(folder)) for f in folder.iterdir() if f.is_file())
+            vid = _digest([self.runtime, str(folder), files, [(folder / f).stat().st_mtime for f in files]])
+            run = {k: manifest["run"][k] for k in ("step", "stop", "algorithm")}
+            run.update({k[4:]: v for k, v in overrides.items()})
+            if vid not in self.builds:
+                self.builds[vid] = Variant(vid, folder, None, _variables(folder))
+            return Variant(vid, folder, run, self.builds[vid].variables)
+        from .fmi.build import build_scene, fmu_specs
+        try:
+            scene = self.scene(overrides)
+            vid = _digest([self.runtime, fmu_specs(scene)[0]])
+        except InputError as exc:
+            return Variant(error=str(exc))
+        run = {k: scene.run[k] for k in ("step", "stop", "algorithm")}
+        if vid not in self.builds:
+            home = self.out / "builds" / vid
+            folder = home / scene.name
+            try:
+                if not (folder / "manifest.json").is_file():
+                    self.log(f"building variant {vid} ({_describe(overrides) or 'the scene as it is'})")
+                    build_scene(scene, home, log=lambda *_: None)
+                self.builds[vid] = Variant(vid, folder, None, _variables(folder))
+            except Exception as exc:  # a build failure stops this variant's cases only
+                self.builds[vid] = Variant(vid, error=f"build failed: {type(exc).__name__}: {exc}")
+        built = self.builds[vid]
+        return Variant(vid, built.folder, run, built.variables, built.error)
+
+    def exposed_error(self, key, value):
+        """The scene's own verdict on an exposed value (read once per distinct value)."""
+        if (key, repr(value)) not in self.checked:
+            error = None
+            if self.batch.scene.is_dir():
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                    error = f"{key}: expected a finite number, found {value!r}"
+            else:
+                try:
+                    self.scene({key: value})
+                except InputError as exc:
+                    error = str(exc)
+            self.checked[(key, repr(value))] = error
+        return self.checked[(key, repr(value))]
+
+
+def _variables(folder):
+    """{'instance.variable': causality} of a built scene's FMUs."""
+    from fmpy import read_model_description
+    manifest = json.loads((Path(folder) / "manifest.json").read_text())
+    out = {}
+    for name, inst in manifest["instances"].items():
+        for v in read_model_description(str(Path(folder) / inst["fmu"])).modelVariables:
+            out[f"{name}.{v.name}"] = v.causality
+    connected = {f"{dst}.{dvar}" for _, _, dst, dvar in manifest["connections"]}
+    return {k: c for k, c in out.items() if not (c == "input" and k in connected)}
+
+
+def _describe(knobs):
+    return ", ".join(f"{k} = {v}" for k, v in knobs.items())
+
+
+def _blob(variant):
+    """The built folder as bytes: what the workers receive."""
+    return {"id": variant.id, "files": {f.name: f.read_bytes() for f in sorted(variant.folder.iterdir())
+                                        if f.is_file()}}
+
+
+# --- one case, on a worker ----------------------------------------------------------
+
+_LOCK = threading.Lock()   # one co-simulation at a time per process (pythonfmu hosts in-process)
+
+
+def _materialize(blob):
+    """The shipped FMUs in a folder of this worker (written once per variant)."""
+    try:
+        from distributed import get_worker
+        base = Path(get_worker().local_directory)
+    except (ImportError, ValueError):
+        base = Path(tempfile.gettempdir())
+    folder = base / "hydrofmu-batch" / blob["id"]
+    if not (folder / "manifest.json").is_file():
+        tmp = folder.with_name(f".{blob['id']}.{os.getpid()}.{uuid.uuid4().hex[:8]}")
+        tmp.mkdir(parents=True)
+        for name, data in blob["files"].items():
+            (tmp / name).write_bytes(data)
+        try:
+            tmp.rename(folder)
+        except OSError:   # another process got there first
+            shutil.rmtree(tmp, ignore_errors=True)
+    return folder
+
+
+def statistics(time_, values, outputs, transient=0.0):
+    """{'<output>.max|min|mean|std|final': value} over the samples with t ≥ transient
+    (mean and std: plain sample statistics, the steps being equal)."""
+    keep = values[time_ >= transient - 1e-9 * max(1.0, abs(transient))]
+    out = {}
+    for j, name in enumerate(outputs):
+        col = keep[:, j]
+        for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), col[-1])):
+            out[f"{name}.{stat}"] = float(value)
+    return out
+
+
+def run_case(task, blob):
+    """Run one case on a worker; never raises for a failing case (status 'failed', error)."""
+    from .cosim.master import run
+    with _LOCK:
+        t0 = time.perf_counter()
+        out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None}
+        try:
+            folder = _materialize(blob)
+            t0 = time.perf_counter()
+            result = run(folder, record=task["outputs"], parameters=task["parameters"], progress=False,
+                         **task["run"])
+        except Exception as exc:   # a failing case is reported, the batch goes on
+            out.update(status="failed", error=f"{type(exc).__name__}: {exc}", wall_s=time.perf_counter() - t0)
+            return out
+        out["wall_s"] = time.perf_counter() - t0
+        values = result.values
+        bad = ~np.isfinite(values)
+        if bad.any():
+            k, j = np.argwhere(bad)[0]
+            out.update(status="failed", error=f"diverged: {task['outputs'][j]} = {values[k, j]} at t = "
+                                              f"{result.time[k]:g} s")
+        out["stats"] = statistics(result.time, values, task["outputs"], task["transient"])
+        if task["series"]:
+            out["series"] = (result.time, values)
+        try:
+            from distributed import get_worker
+            out["worker"] = get_worker().address
+        except (ImportError, ValueError):
+            pass
+        return out
+
+
+# --- the batch ----------------------------------------------------------------------
+
+def _write_json(path, obj):
+    """Atomic: a killed batch leaves whole files or none."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(obj, default=str))
+    os.replace(tmp, path)
+
+
+def _done(path, retry_failed):
+    try:
+        status = json.loads(path.read_text())["status"]
+    except (OSError, ValueError, KeyError):
+        return False
+    return status == "ok" or (status == "failed" and not retry_failed)
+
+
+class Progress:
+    """A progress line on stderr: cases done, failed, skipped, the estimated time left."""
+
+    def __init__(self, total, stream=None, enabled=True):
+        self.total, self.stream, self.enabled = total, stream or sys.stderr, enabled
+        self.done = self.failed = self.skipped = 0
+        self.t0, self.last = time.perf_counter(), 0.0
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+
+    def update(self, ok=None, skipped=False, force=False):
+        if skipped:
+            self.skipped += 1
+        elif ok is not None:
+            self.done += 1
+            self.failed += not ok
+        now = time.perf_counter()
+        if not self.enabled or (not force and now - self.last < (0.2 if self.tty else 10.0)):
+            return
+        self.last = now
+        finished = self.done + self.skipped
+        eta = ((now - self.t0) / self.done * (self.total - finished)) if self.done else float("nan")
+        bar = "#" * int(30 * finished / max(self.total, 1))
+        line = (f"batch [{bar:<30}] {finished}/{self.total} cases, {self.failed} failed"
+                + (f", {self.skipped} from an earlier run" if self.skipped else "")
+                + (f", {_clock(eta)} left" if math.isfinite(eta) and finished < self.total else ""))
+        self.stream.write(("\r" + line) if self.tty else line + "\n")
+        self.stream.flush()
+
+    def close(self):
+        self.update(force=True)
+        if self.enabled and self.tty:
+            self.stream.write("\n")
+
+
+def _clock(seconds):
+    seconds = int(round(seconds))
+    return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}" if seconds >= 3600 else \
+        f"{seconds // 60}:{seconds % 60:02d}"
+
+
+def _open_client(client, scheduler, workers):
+    """(client, things to close): the given client, one on ``scheduler``, or a LocalCluster."""
+    import logging
+    from distributed import Client, LocalCluster
+    if client is not None:
+        return client, []
+    if scheduler:
+        c = Client(scheduler)
+        return c, [c]
+    cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    c = Client(cluster)
+    return c, [c, cluster]
+
+
+def _plan(batch, variants, log):
+    """(case id, knobs, variant, task, error) of every case, lazily.  Names every case
+    shares (outputs, FMU variables) are checked on the first case: a wrong one is an
+    InputError; a bad value is the error of its case only."""
+    first, unused = True, set()
+    for knobs in batch.cases():
+        exposed = {k: v for k, v in knobs.items() if k in EXPOSED}
+        direct = {k: v for k, v in knobs.items()
+                  if k not in EXPOSED and k.split(".", 1)[0].split("[", 1)[0] not in SCENE_SECTIONS}
+        overrides = {k: v for k, v in knobs.items() if k not in exposed and k not in direct}
+        variant = variants.get(overrides)
+        errors = [variant.error] if variant.error else []
+        errors += [e for e in (variants.exposed_error(k, v) for k, v in exposed.items()) if e]
+        parameters = {}
+        if variant.variables is not None:
+            wrong = [k for k in direct if variant.variables.get(k) not in ("input", "parameter")]
+            missing = [o for o in batch.outputs if o not in variant.variables]
+            problems = ([f"{k}: not a parameter or unconnected input of the FMUs" for k in wrong]
+                        + ([f"not outputs of the FMUs: {', '.join(missing)}"] if missing else []))
+            if problems and first:
+                raise InputError(batch.path, None, "outputs" if missing else wrong[0], "; ".join(problems))
+            errors += problems
+            for key, value in exposed.items():
+                names = [n for n, c in variant.variables.items()
+                         if n.split(".", 1)[1] == EXPOSED[key] and c in ("input", "parameter")]
+                if not names and key not in unused:
+                    unused.add(key)
+                    log(f"note: {key} changes nothing: no FMU of the scene has {EXPOSED[key]}")
+                parameters.update(dict.fromkeys(names, value))
+            parameters.update(direct)
+            first = False
+        cid = _digest([sorted(knobs.items()), variant.id, variant.error, variant.run, parameters,
+                       batch.outputs, batch.transient])
+        task = {"case": cid, "run": variant.run, "parameters": parameters, "outputs": batch.outputs,
+                "transient": batch.transient, "series": batch.series}
+        yield cid, knobs, variant, task, "; ".join(errors) or None
+
+
+def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None, retry_failed=False,
+              progress=True, log=None, window=None):
+    """Run a batch; returns its table (pandas DataFrame, one row per case).
+
+    ``cases``: a case file, a dict of the same content or a ``Batch``; ``out``: results
+    folder (``cases/``, ``cases.csv``, ``cases.parquet``, ``cases.png``, ``series/``, ``builds/``);
+    ``workers``: LocalCluster size (default: this machine's cores); ``scheduler``: address
+    of an existing Dask scheduler; ``client``: an existing ``distributed.Client``;
+    ``series``: write each case's time series (default: the case file's ``series``);
+    ``retry_failed``: rerun failed cases too (cases that lost their worker always rerun);
+    ``window``: cases in flight at once (default: twice the worker threads).
+    """
+    batch = cases if isinstance(cases, Batch) else load_cases(cases)
+    if series is not None:
+        batch.series = series
+    log = log or (lambda text: print(text, file=sys.stderr))
+    out = Path(out)
+    (out / "cases").mkdir(parents=True, exist_ok=True)
+    if batch.series:
+        (out / "series").mkdir(exist_ok=True)
+    variants = Variants(batch, out, log)
+    token = uuid.uuid4().hex[:12]
+    ids = []
+    bar = Progress(len(batch), enabled=progress)
+    client_, closing = None, []
+
+    def record(cid, knobs, variant, result):
+        if result.get("series") is not None:
+            _write_series(out / "series" / f"{cid}.parquet", *result["series"], batch.outputs)
+        _write_json(out / "cases" / f"{cid}.json", {
+            "case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
+            "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
+            "worker": result.get("worker")})
+        bar.update(ok=result["status"] == "ok")
+
+    try:
+        inflight, seen, ac = {}, set(), None
+        for cid, knobs, variant, task, error in _plan(batch, variants, log):
+            ids.append(cid)
+            if cid in seen:   # the same case twice in the file: run once
+                bar.update(skipped=True)
+                continue
+            seen.add(cid)
+            path = out / "cases" / f"{cid}.json"
+            if _done(path, retry_failed) and (not batch.series or (out / "series" / f"{cid}.parquet").is_file()):
+                bar.update(skipped=True)
+                continue
+            if error:
+                record(cid, knobs, variant, {"status": "failed", "error": error, "wall_s": None, "stats": {}})
+                continue
+            if client_ is None:
+                from distributed import as_completed
+                client_, closing = _open_client(client, scheduler, workers)
+                bar.t0 = time.perf_counter()   # the estimate counts case time, not start-up
+                ac = as_completed()
+                threads = sum(w.get("nthreads", 1) for w in client_.scheduler_info()["workers"].values())
+                window = window or max(2, 2 * threads)
+            shared = variants.builds[variant.id]
+            if shared.blob is None:   # the FMUs go to the workers once per build, as bytes
+                shared.blob = client_.scatter([_blob(shared)], hash=False)[0]   # (a dict would scatter by key)
+            while len(inflight) >= window:
+                _collect(next(ac), inflight, record)
+            future = client_.submit(run_case, task, shared.blob, key=f"case-{cid}-{token}", pure=False)
+            inflight[future] = (cid, knobs, variant)
+            ac.add(future)
+        while inflight:
+            _collect(next(ac), inflight, record)
+    finally:
+        for c in closing:
+            c.close()
+        bar.close()
+    return assemble(out, ids, batch)
+
+
+def _collect(future, inflight, record):
+    cid, knobs, variant = inflight.pop(future)
+    try:
+        result = future.result()
+    except Exception as exc:   # the worker was lost (KilledWorker, connection closed…)
+        result = {"status": "lost", "error": f"{type(exc).__name__}: {exc}", "wall_s": None, "stats": {}}
+    future.release()
+    record(cid, knobs, variant, result)
+
+
+def _write_series(path, time_, values, outputs):
+    import pandas as pd
+    frame = pd.DataFrame(values, columns=outputs)
+    frame.insert(0, "time", time_)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    frame.to_parquet(tmp, index=False)
+    os.replace(tmp, path)
+
+
+def read_series(out, case):
+    """The time series of one case (DataFrame: time and the outputs)."""
+    import pandas as pd
+    return pd.read_parquet(Path(out) / "series" / f"{case}.parquet")
+
+
+def assemble(out, ids, batch):
+    """The batch table from the per-case files: one row per case (knobs, status, wall time,
+    statistics, error, case id, build id); written as cases.csv, cases.parquet and the plot."""
+    import pandas as pd
+    rows = []
+    for cid in ids:
+        r = json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
+        rows.append({**{k: _cell(v) for k, v in r["knobs"].items()}, "status": r["status"], "wall_s": r["wall_s"],
+                     **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
+    stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
+    columns = batch.keys + ["status", "wall_s"] + stats + ["error", "case", "build"]
+    table = pd.DataFrame(rows, columns=columns)
+    table.to_csv(Path(out) / "cases.csv", index=False)
+    table.to_parquet(Path(out) / "cases.parquet", index=False)
+    plot(table, batch, Path(out) / "cases.png")
+    return table
+
+
+def _cell(value):
+    return json.dumps(value) if isinstance(value, (list, dict)) else value
+
+
+DIRECTION_HINTS = ("direction", "heading")
+
+
+def plot(table, batch, path):
+    """Largest |output| per case: a polar plot against the first direction knob (one line per
+    combination of the other knobs), else against the first numeric knob; None if neither."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    ok = table[table["status"] == "ok"]
+    numeric = [k for k in batch.matrix if len(batch.matrix[k]) > 1
+               and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in batch.matrix[k])]
+    if ok.empty or not numeric:
+        return None
+    axis = next((k for k in numeric if any(h in k.lower() for h in DIRECTION_HINTS)), numeric[0])
+    polar = any(h in axis.lower() for h in DIRECTION_HINTS)
+    others = [k for k in batch.matrix if k != axis and len(batch.matrix[k]) > 1]
+    n = len(batch.outputs)
+    fig, axes = plt.subplots(1, n, figsize=(5 * n, 4.8), squeeze=False,
+                             subplot_kw={"projection": "polar"} if polar else {})
+    for ax, name in zip(axes[0], batch.outputs):
+        peak = np.maximum(ok[f"{name}.max"].abs(), ok[f"{name}.min"].abs())
+        groups = ok.groupby(others, sort=True) if others else [((), ok)]
+        for label, g in groups:
+            g = g.sort_values(axis)
+            x = np.radians(g[axis].to_numpy(float)) if polar else g[axis].to_numpy(float)
+            y = peak[g.index].to_numpy()
+            label = ", ".join(f"{k} = {v}" for k, v in zip(others, label if isinstance(label, tuple) else (label,)))
+            ax.plot(x, y, "o-", label=label or None)
+        ax.set_title(f"max |{name}|", fontsize=9)
+        if not polar:
+            ax.set_xlabel(axis)
+            ax.grid(True, alpha=0.3)
+        if others:
+            ax.legend(fontsize=7)
+    fig.suptitle(f"{batch.scene.stem}: largest value per case against {axis}"
+                 + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

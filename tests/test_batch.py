@@ -1,0 +1,153 @@
+"""Load-case batches (``hydrofmu batch``) on a local Dask cluster of 2 worker processes,
+started once for the module.  Each case is checked against the single-run API on a scene
+built with the case's values written into it, so FMU-exposed knobs (set at initialisation,
+sharing one build) must give what a rebuilt scene gives."""
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from distributed import Client, LocalCluster
+
+from hydrofmu.batch import load_cases, run_batch
+from hydrofmu.cosim.master import run
+from hydrofmu.errors import InputError
+from hydrofmu.fmi.build import build_scene
+from hydrofmu.scene import load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "models" / "moored_barge.toml"
+OUTPUTS = ["barge_dynamics.position[1]", "barge_dynamics.position[2]", "barge.force[2]"]
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def case_file(folder, body, stop=10.0):
+    path = Path(folder) / "cases.toml"
+    path.write_text(f'scene = "{SCENE}"\nstop = {stop}\noutputs = {json.dumps(OUTPUTS)}\n{body}')
+    return path
+
+
+def test_batch_equals_single_runs(client, tmp_path):
+    cases = case_file(tmp_path, """
+[matrix]
+"environment.current_speed" = [0.5, 1.5]
+"environment.current_direction" = [30.0, 200.0]
+[[cases]]                      # a knob the build bakes in, with one the FMUs expose
+"run.substep" = 0.05
+"environment.current_speed" = 0.8
+""")
+    table = run_batch(cases, tmp_path / "out", client=client, progress=False)
+    assert len(table) == 5 and (table["status"] == "ok").all(), table[["status", "error"]]
+    # the four exposed-knob cases share one build, the substep case has its own
+    assert table["build"].iloc[:4].nunique() == 1 and table["build"].iloc[4] != table["build"].iloc[0]
+    assert len(list((tmp_path / "out" / "builds").iterdir())) == 2
+    for _, row in table.iterrows():
+        knobs = {k: row[k] for k in ("environment.current_speed", "environment.current_direction", "run.substep")
+                 if pd.notna(row[k])}
+        ref_dir = tmp_path / "ref" / row["case"]
+        folder = build_scene(load_scene(SCENE, {**knobs, "run.stop": 10.0}), ref_dir, log=lambda *_: None)
+        ref = run(folder, record=OUTPUTS, progress=False)
+        for j, name in enumerate(OUTPUTS):
+            x = ref.values[:, j]
+            want = {"max": x.max(), "min": x.min(), "mean": x.mean(), "std": x.std(), "final": x[-1]}
+            for stat, value in want.items():
+                assert row[f"{name}.{stat}"] == pytest.approx(value, rel=1e-12, abs=1e-12 * np.abs(x).max()), \
+                    (row["case"], name, stat)
+    # the cases really differ (the knobs reached the FMUs): the sway offset grows with speed
+    sway = table["barge_dynamics.position[2].max"].to_numpy()
+    assert sway[2] > 5 * sway[0] > 0
+    written = pd.read_csv(tmp_path / "out" / "cases.csv")
+    assert list(written["case"]) == list(table["case"])
+    assert pd.read_parquet(tmp_path / "out" / "cases.parquet").shape == table.shape
+    assert (tmp_path / "out" / "cases.png").stat().st_size > 0
+
+
+def test_failing_cases_are_reported_and_the_others_finish(client, tmp_path):
+    cases = case_file(tmp_path, """
+[matrix]
+"environment.current_speed" = [0.5, 1.0]
+[[cases]]                      # 1 kg on the barge's mooring: the dynamics blow up
+"bodies.barge.mass" = 1.0
+[[cases]]                      # NaN water density: NaN loads
+"barge.rho" = nan
+[[cases]]                      # bad input, refused by the scene's own check
+"environment.current_speed" = -1.0
+""")
+    table = run_batch(cases, tmp_path / "out", client=client, progress=False, series=True)
+    assert list(table["status"]) == ["ok", "ok", "failed", "failed", "failed"]
+    assert table["error"].iloc[:2].isna().all() and table["error"].iloc[2:].str.len().min() > 0
+    assert "environment.current_speed" in table["error"].iloc[4]
+    ok = table.iloc[:2]
+    assert np.isfinite(ok[[f"{o}.max" for o in OUTPUTS]].to_numpy()).all()
+    # time series on request, for the cases that ran to the end
+    series = pd.read_parquet(tmp_path / "out" / "series" / f"{ok['case'].iloc[1]}.parquet")
+    assert list(series.columns) == ["time"] + OUTPUTS and len(series) == 101
+    assert series[OUTPUTS[1]].max() == pytest.approx(ok[f"{OUTPUTS[1]}.max"].iloc[1], rel=1e-15)
+
+
+def test_killed_batch_reruns_only_missing_cases(client, tmp_path):
+    directions = list(range(0, 360, 30))
+    cases = case_file(tmp_path, f'[matrix]\n"environment.current_direction" = {directions}\n', stop=20.0)
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "hydrofmu.cli", "batch", str(cases), "-o", str(out),
+                             "--workers", "1"], start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 180
+        while len(list(out.glob("cases/*.json"))) < 3 and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)   # the batch, its cluster and workers: one process group
+        proc.wait()
+    before = {p.name: p.read_text() for p in out.glob("cases/*.json")}
+    assert 3 <= len(before) < len(directions), "the batch was not killed half-way"
+    logs = []
+    table = run_batch(cases, out, client=client, progress=False, log=logs.append)
+    assert (table["status"] == "ok").all() and len(table) == len(directions)
+    assert not any(line.startswith("building") for line in logs)   # the killed run's build is reused
+    after = {p.name: json.loads(p.read_text()) for p in out.glob("cases/*.json")}
+    assert all(after[name] == json.loads(text) for name, text in before.items())   # untouched
+    fresh = [r for name, r in after.items() if name not in before]
+    assert len(fresh) == len(directions) - len(before) and len({r["batch"] for r in fresh}) == 1
+    assert {r["batch"] for r in fresh}.isdisjoint(json.loads(t)["batch"] for t in before.values())
+    # a third run has nothing left to do
+    logs.clear()
+    again = run_batch(cases, out, client=client, progress=False, log=logs.append)
+    assert {p.name: json.loads(p.read_text()) for p in out.glob("cases/*.json")} == after
+    pd.testing.assert_frame_equal(again, table)
+
+
+def test_case_file_errors(tmp_path):
+    def error(body, scene=SCENE):
+        path = tmp_path / "bad.toml"
+        path.write_text(f'scene = "{scene}"\n{body}')
+        with pytest.raises(InputError) as exc:
+            load_cases(path)
+        assert str(path) in str(exc.value)
+        return exc.value
+    assert error('outputs = []').field == "outputs"
+    assert error('outputs = ["barge.force[1]"]\nmatrx = 1').field == "matrx"
+    assert error('outputs = ["a.b"]', scene=tmp_path / "none.toml").field == "scene"
+    assert error('outputs = ["a.b"]\n[matrix]\nbogus = [1]').field == "bogus"
+    assert error('outputs = ["a.b"]\nstop = -1').field == "stop"
+    # a name every case shares is checked on the first case, before any case runs
+    path = case_file(tmp_path, '[matrix]\n"barge.no_such_parameter" = [1.0]\n')
+    with pytest.raises(InputError, match="barge.no_such_parameter"):
+        run_batch(path, tmp_path / "out", progress=False)
+    assert not list((tmp_path / "out" / "cases").iterdir())
