@@ -469,9 +469,6 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
         batch.series = series
     log = log or (lambda text: print(text, file=sys.stderr))
     out = Path(out)
-    (out / "cases").mkdir(parents=True, exist_ok=True)
-    if batch.series:
-        (out / "series").mkdir(exist_ok=True)
     variants = Variants(batch, out, log)
     token = uuid.uuid4().hex[:12]
     ids = []
@@ -479,7 +476,9 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
     client_, closing = None, []
 
     def record(cid, knobs, variant, result):
+        (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
         if result.get("series") is not None:
+            (out / "series").mkdir(exist_ok=True)
             _write_series(out / "series" / f"{cid}.parquet", *result["series"], batch.outputs)
         _write_json(out / "cases" / f"{cid}.json", {
             "case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
