@@ -294,7 +294,7 @@ def test_asymmetric_a_inf_beyond_tolerance(tmp_path):
     assert str(path) in msg and "added_mass[inf][cyl1__Surge, cyl1__Pitch]: infinite-frequency added mass asymmetric" in msg
     # within a looser declared tolerance it is symmetrised
     scene = load_scene(write_scene(tmp_path, bodies_text() + bem_text(path, "symmetry_tolerance = 0.2")))
-    am = np.array(scene.couplings[0].data["added_mass"])
+    am = np.array(scene.couplings[0].added_mass)
     np.testing.assert_allclose(am, am.T)
 
 
@@ -326,11 +326,11 @@ def test_bem2simo_deck_gives_the_same_loads(tmp_path):
     v = rng.normal(size=(300, 6)) * 0.1
     for c_bem, c_simo in zip(scene.couplings, simo.couplings):
         assert (c_bem.a, c_bem.b) == (c_simo.a, c_simo.b)
-        np.testing.assert_allclose(c_simo.data["added_mass"], c_bem.data["added_mass"], rtol=1e-9, atol=1e-6)
+        np.testing.assert_allclose(c_simo.added_mass, c_bem.added_mass, rtol=1e-9, atol=1e-6)
         m_bem, m_simo = c_bem.model(), c_simo.model()
         for side in m_bem.sides:
-            f1 = np.array([m_bem.advance(side, 0.05, x) for x in v])
-            f2 = np.array([m_simo.advance(side, 0.05, x) for x in v])
+            f1 = np.array([m_bem.memory[side].advance(0.05, x) for x in v])
+            f2 = np.array([m_simo.memory[side].advance(0.05, x) for x in v])
             np.testing.assert_allclose(f2, f1, rtol=0, atol=1e-9 * np.abs(f1).max())
 
 

@@ -578,8 +578,8 @@ F_TOW = np.array([2.0e5, -1.0e5, 0.0, 0.0, 0.0, 3.0e5])
 
 def in_process(data):
     """The two memories as the load FMU builds them (side A of each coupling)."""
-    conv = Coupling(data["SELFC"], "convolution").memory["A"]
-    ss = Coupling(data["AB"], "state_space", AB_TOL).memory["A"]
+    conv = Coupling.from_deck(data["SELFC"], "convolution").memory["A"]
+    ss = Coupling.from_deck(data["AB"], "state_space", AB_TOL).memory["A"]
     return conv, ss
 
 

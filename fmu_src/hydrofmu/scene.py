@@ -12,18 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .description import Effect, HydroCoupling, Kernel
 from .errors import InputError
 
 ACCEL_MODES = ("export", "explicit")
-
-
-@dataclass
-class Effect:
-    """One load model on one body: ``type`` (see EFFECT_TYPES), unique ``name`` and the
-    data the kernel needs (plain JSON-able values, decks already read)."""
-    type: str
-    name: str
-    data: dict
 
 
 @dataclass
@@ -323,34 +315,6 @@ PRESETS = {
 COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length"}
 
 
-@dataclass
-class Coupling:
-    """A SIMO hydrodynamic coupling between scene bodies ``a`` and ``b`` (a == b: the
-    body's own radiation memory).  ``data``: added_mass (6×6), timdel [s] and kernels
-    [[IDOF_A, IDOF_B, [values…]], …]; ``method``: 'convolution' | 'state_space'
-    (with ``tolerance`` or ``order``); ``memory_length`` [s] truncates the kernels."""
-    name: str
-    a: str
-    b: str
-    data: dict
-    method: str = "convolution"
-    tolerance: float = 0.01
-    order: object = None
-    memory_length: object = None
-    set: list = field(default_factory=list)   # memory knobs the scene sets itself
-    bem: object = None                        # bem.BemCouplings when made from a BEM result
-
-    def model(self, v0_a=None, v0_b=None):
-        """The physics.coupling.Coupling of this coupling, with its own evaluator settings
-        (v0_a, v0_b: the bodies' velocities at the start)."""
-        from types import SimpleNamespace
-        from .physics.coupling import Coupling as Model
-        data = SimpleNamespace(name=self.name, body_a=self.a, body_b=self.b, added_mass=self.data["added_mass"],
-                               timdel=self.data["timdel"],
-                               kernels={(i, j): np.asarray(h, float) for i, j, h in self.data["kernels"]})
-        return Model(data, self.method, self.tolerance, self.order, self.memory_length, v0_a=v0_a, v0_b=v0_b)
-
-
 def _memory_knobs(problems, table, where, memory):
     """(method, tolerance, order, memory_length, knobs the table sets) of a coupling entry."""
     method = problems.choice(table, "method", f"{where}.method", ("convolution", "state_space"), memory["method"])
@@ -391,8 +355,8 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         known = set(mapping) | set(bodies)
         path = _deck_path(problems, table, where)
         name = problems.string(table, "coupling", f"{where}.coupling")
-        method, tol, order, length, knobs = _memory_knobs(problems, table, where, memory)
-        if path is None or name is None or method is None:
+        knobs = _memory_knobs(problems, table, where, memory)
+        if path is None or name is None or knobs[0] is None:
             continue
         try:
             key = (str(path), frozenset(known))   # a deck holds many couplings: read it once
@@ -414,14 +378,17 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         if not identifier(name) or name in names:
             problems.add(f"{where}.coupling", f"coupling names must be distinct identifiers, found {name!r}")
         names.add(name)
-        out.append(Coupling(name, a, b, _coupling_data(d), method, tol, order, length, knobs))
+        out.append(_coupling(name, a, b, d, knobs))
     return out
 
 
-def _coupling_data(d):
-    """A scene coupling's plain data from a ``decks.simo.CouplingData``."""
-    return {"added_mass": np.asarray(d.added_mass, float).tolist(), "timdel": d.timdel,
-            "kernels": [[i_, j_, np.asarray(h, float).tolist()] for (i_, j_), h in d.kernels.items()]}
+def _coupling(name, a, b, d, knobs, bem=None):
+    """A scene coupling from the arrays of a ``decks.simo.CouplingData`` (or alike) and the
+    memory knobs of its entry (``_memory_knobs``)."""
+    method, tol, order, length, set_ = knobs
+    return HydroCoupling(name, a, b, np.asarray(d.added_mass, float), d.timdel,
+                         [Kernel(i, j, np.asarray(h, float)) for (i, j), h in d.kernels.items()],
+                         method, tol, order, length, set_, bem=bem)
 
 
 BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance",
@@ -449,8 +416,8 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
         dofs = None
     opt = {k: problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None
            for k in ("ulen", "timdel", "kernel_length", "symmetry_tolerance")}
-    method, tol, order, length, knobs = _memory_knobs(problems, table, where, memory)
-    if file is None or mapping is None or method is None or prefix is None or not identifier(prefix):
+    knobs = _memory_knobs(problems, table, where, memory)
+    if file is None or mapping is None or knobs[0] is None or prefix is None or not identifier(prefix):
         if prefix is not None and not identifier(prefix):
             problems.add(f"{where}.name", f"expected an identifier, found {prefix!r}")
         return []
@@ -473,8 +440,7 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
     except InputError as exc:
         problems.add(f"{where}.bem", str(exc))
         return []
-    return [Coupling(c.name, c.body_a, c.body_b, _coupling_data(c), method, tol, order, length, knobs, bem=result)
-            for c in result.couplings]
+    return [_coupling(c.name, c.body_a, c.body_b, c, knobs, bem=result) for c in result.couplings]
 
 
 def _check_centres(data, mapping, bodies):

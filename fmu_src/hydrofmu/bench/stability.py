@@ -106,7 +106,6 @@ tangent linearisation, gain 2·k·|W|, would halve both limits: it describes sma
 perturbations of a decaying solution, not whether the amplitude grows.)
 """
 import math
-from types import SimpleNamespace
 
 import numpy as np
 from scipy.linalg import expm
@@ -338,9 +337,7 @@ def cross_body_run(cross, mass_a=MASS, mass_b=MASS, self_a=None, self_b=None, dt
     ``v0`` [m/s] in surge, sway and heave, B at rest.  Growth: max over the last quarter of
     max(|x|/X, |v|/v0, |F|/(K·X)), X = v0·T/(2π), over both bodies and all translations;
     inf if it diverged."""
-    data = SimpleNamespace(name="AB", body_a="A", body_b="B", added_mass=np.asarray(cross, float),
-                           timdel=1.0, kernels={})
-    coupling = Coupling(data)
+    coupling = Coupling(cross, name="AB")
     omega = 2.0 * math.pi / period
     sub = min(dt, period / 50.0)
     bodies = [_oscillator(m, m * omega ** 2, 2.0 * zeta * m * omega, own, v, sub)

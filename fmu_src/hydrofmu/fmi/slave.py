@@ -10,24 +10,19 @@ next fmi2GetReal (or fmi2DoStep) evaluates the kernels with the inputs as they a
 Bad input values never raise into the host: the slave logs an error and fmi2DoStep
 returns False, which hydrofmu's binary shim reports as fmi2Error.
 """
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 from pythonfmu import Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
-from types import SimpleNamespace
-
-from ..physics.coupling import Coupling
+from .. import description
 from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
 from ..physics.rigid_body import CoupledBodies, RigidBody
 from ..physics.state import Env, Motion
 
-CONFIG = "hydrofmu.json"
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 LIN_ROT = {
     "velocity": ["m/s"] * 3 + ["rad/s"] * 3,
@@ -44,8 +39,8 @@ class ArraySlave(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.config = json.loads((Path(self.resources) / CONFIG).read_text())
-        self.description = self.config.get("description")
+        self.config = description.read(self.resources)   # this FMU's typed description
+        self.description = self.config.description
         self._start = []        # start values while registering
         self.units = {}         # variable name -> unit
         self.dependencies = {}  # output name -> input names
@@ -96,15 +91,15 @@ class ArraySlave(Fmi2Slave):
 
     def add_environment(self, uses_current):
         """current.speed/direction inputs (if used) and rho, g parameters."""
-        cfg = self.config
+        env = self.config.environment
         self.current = None
         if uses_current:
             self.current = slice(len(self._start), len(self._start) + 2)
-            self.add("current.speed", Fmi2Causality.input, "m/s", cfg["current_speed"], "uniform current speed")
-            self.add("current.direction", Fmi2Causality.input, "deg", cfg["current_direction"],
+            self.add("current.speed", Fmi2Causality.input, "m/s", env.current_speed, "uniform current speed")
+            self.add("current.direction", Fmi2Causality.input, "deg", env.current_direction,
                      "current 'going to' direction, counter-clockwise from global +x")
-        self.rho = self.add("rho", Fmi2Causality.parameter, "kg/m3", cfg["rho"], "water density")
-        self.g = self.add("g", Fmi2Causality.parameter, "m/s2", cfg["g"], "acceleration of gravity")
+        self.rho = self.add("rho", Fmi2Causality.parameter, "kg/m3", env.rho, "water density")
+        self.g = self.add("g", Fmi2Causality.parameter, "m/s2", env.g, "acceleration of gravity")
         return [self.current] if self.current else []
 
     def add_matrix(self, name, causality, matrix, description):
@@ -174,7 +169,7 @@ class ArraySlave(Fmi2Slave):
             if self.stale and self.error is None:
                 self.evaluate()
             if self.error is None:
-                self.advance(current_time, step_size)
+                self.step_physics(current_time, step_size)
         except Exception as exc:  # never let a Python exception reach the C host
             self.error = f"{type(exc).__name__}: {exc}"
         if self.error is not None:
@@ -186,7 +181,7 @@ class ArraySlave(Fmi2Slave):
     def evaluate(self):
         self.stale = False
 
-    def advance(self, t, dt):
+    def step_physics(self, t, dt):
         pass
 
     # FMU state: the value array plus whatever the slave's physics holds.
@@ -212,28 +207,27 @@ class LoadSlave(ArraySlave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         cfg = self.config
-        explicit = cfg["accel_mode"] == "explicit"
-        self.loads = BodyLoads([make_effect(e["type"], e["name"], e["data"]) for e in cfg["effects"]], explicit)
+        explicit = cfg.accel_mode == "explicit"
+        self.loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in cfg.effects], explicit)
         Out, In = Fmi2Causality.output, Fmi2Causality.input
-        couplings = cfg.get("couplings", [])
-        own_acc = explicit and (self.loads.uses_acceleration or any(c["self"] for c in couplings))
-        self.motion_inputs = self.add_motion("", cfg["position"], cfg["attitude"], own_acc)
+        own_acc = explicit and (self.loads.uses_acceleration or any(c.own for c in cfg.couplings))
+        self.motion_inputs = self.add_motion("", cfg.position, cfg.attitude, own_acc)
         inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
         # hydrodynamic couplings: the source body's velocity (and acceleration) in
         self.couplings = []
-        for c in couplings:
-            src = c["source"]
-            vel = self.motion_inputs[2] if c["self"] else self.add_vector(
+        for c in cfg.couplings:
+            src = c.source
+            vel = self.motion_inputs[2] if c.own else self.add_vector(
                 f"{src}.velocity", 6, In, LIN_ROT["velocity"], None, f"velocity of coupled body {src}, global")
             acc = None
             if explicit:
-                acc = self.motion_inputs[3] if c["self"] else self.add_vector(
+                acc = self.motion_inputs[3] if c.own else self.add_vector(
                     f"{src}.acceleration", 6, In, LIN_ROT["acceleration"], None,
                     f"acceleration of coupled body {src}, global")
-            out = self.add_vector(f"{c['name']}.force", 6, Out, LIN_ROT["force"], None,
-                                  f"hydrodynamic coupling {c['name']} (from {src}'s motion)")
+            out = self.add_vector(f"{c.name}.force", 6, Out, LIN_ROT["force"], None,
+                                  f"hydrodynamic coupling {c.name} (from {src}'s motion)")
             self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
-                                   "mass": np.asarray(c["mass"], dtype=float), "memory": None})
+                                   "mass": c.mass, "memory": None})
             inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
         self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
                                      "total load on the body, global axes, moments about the reference point")
@@ -248,22 +242,16 @@ class LoadSlave(ArraySlave):
                                                                                    np.array(self._start))))
         if not explicit:
             for c in self.couplings:
-                self.add_mass_export(f"{c['cfg']['name']}.mass_matrix", np.asarray(c["cfg"]["mass"]))
+                self.add_mass_export(f"{c['cfg'].name}.mass_matrix", c["mass"])
         self.finish_registration()
         self.stale = True
 
     def exit_initialization_mode(self):
         for c in self.couplings:
-            cfg = c["cfg"]
-            d = cfg["data"]
-            v0 = self.values[c["velocity"]].copy()
-            data = SimpleNamespace(name=cfg["name"], body_a="A", body_b="A" if cfg["self"] else "B",
-                                   added_mass=d["added_mass"], timdel=d["timdel"],
-                                   kernels={(i, j): np.asarray(h) for i, j, h in d["kernels"]})
-            if d["kernels"]:
-                model = Coupling(data, cfg["method"], cfg["tolerance"], cfg["order"], cfg["memory_length"],
-                                 v0_a=v0, v0_b=v0)
-                c["memory"] = FeedthroughMemory(model.memory[cfg["side"] if not cfg["self"] else "A"])
+            side = c["cfg"]
+            if side.coupling.kernels:
+                v0 = self.values[c["velocity"]].copy()
+                c["memory"] = FeedthroughMemory(side.coupling.model(v0_a=v0, v0_b=v0).memory[side.side])
         self.stale = True
 
     def evaluate(self):
@@ -284,7 +272,7 @@ class LoadSlave(ArraySlave):
             total = total + load
         self.values[self.force] = total
 
-    def advance(self, t, dt):
+    def step_physics(self, t, dt):
         for c in self.couplings:
             if c["memory"] is not None:
                 c["memory"].commit(self.values[c["velocity"]], dt)
@@ -310,27 +298,28 @@ class DynamicsSlave(ArraySlave):
         super().__init__(**kwargs)
         cfg = self.config
         In, Out, Par = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
-        group = len(cfg["bodies"]) > 1
+        group = len(cfg.bodies) > 1
         self.parts = []
-        for b in cfg["bodies"]:
-            p = f"{b['name']}." if group else ""
+        for b in cfg.bodies:
+            p = f"{b.name}." if group else ""
             part = {"cfg": b}
             part["loads"] = [self.add_vector(f"{p}{src}.force" if src else f"{p}force", 6, In, LIN_ROT["force"],
                                              None, f"load from {src or 'the body FMU'}, global axes, "
                                                    "about the reference point")
-                             for src in b["load_sources"]]
-            part["added"] = self.add_matrix(f"{p}added_mass", Par, b["added_mass"],
+                             for src in b.load_sources]
+            part["added"] = self.add_matrix(f"{p}added_mass", Par, b.added_mass,
                                             "mass contributions exported by load FMUs, global axes")
-            part["position"] = self.add_vector(f"{p}position", 3, Out, "m", b["position"])
-            part["attitude"] = self.add_vector(f"{p}attitude", 3, Out, "rad", b["attitude"])
-            part["velocity"] = self.add_vector(f"{p}velocity", 6, Out, LIN_ROT["velocity"], b["velocity"])
+            part["position"] = self.add_vector(f"{p}position", 3, Out, "m", b.position)
+            part["attitude"] = self.add_vector(f"{p}attitude", 3, Out, "rad", b.attitude)
+            part["velocity"] = self.add_vector(f"{p}velocity", 6, Out, LIN_ROT["velocity"], b.velocity)
             part["acceleration"] = self.add_vector(f"{p}acceleration", 6, Out, LIN_ROT["acceleration"], None)
             self.depends([part[k] for k in ("position", "attitude", "velocity", "acceleration")], [])
             self.parts.append(part)
-        names = [b["name"] for b in cfg["bodies"]]
-        self.cross = {(names.index(a), names.index(b)): self.add_matrix(
-                          f"{a}.{b}.added_mass", Par, m, f"cross added mass: load on {a} from {b}'s acceleration")
-                      for a, b, m in cfg.get("cross", [])}
+        names = [b.name for b in cfg.bodies]
+        self.cross = {(names.index(c.target), names.index(c.source)): self.add_matrix(
+                          f"{c.target}.{c.source}.added_mass", Par, c.mass,
+                          f"cross added mass: load on {c.target} from {c.source}'s acceleration")
+                      for c in cfg.cross}
         self.load_inputs = [s for part in self.parts for s in part["loads"]]
         self.finish_registration()
         self.solver = None
@@ -342,11 +331,10 @@ class DynamicsSlave(ArraySlave):
         for part in self.parts:
             b = part["cfg"]
             bodies.append(RigidBody(
-                mass=b["mass"], inertia=np.asarray(b["inertia"]), cog=np.asarray(b["cog"]),
-                stiffness=np.asarray(b["stiffness"]), damping=np.asarray(b["damping"]),
+                mass=b.mass, inertia=b.inertia, cog=b.cog, stiffness=b.stiffness, damping=b.damping,
                 added_mass=v[part["added"]].reshape(6, 6).copy(),
                 position0=v[part["position"]].copy(), attitude0=v[part["attitude"]].copy(),
-                velocity0=v[part["velocity"]].copy(), max_substep=self.config["substep"]))
+                velocity0=v[part["velocity"]].copy(), max_substep=self.config.substep))
         self.bodies = bodies
         if self.cross:
             self.solver = CoupledBodies(bodies, {k: v[s].reshape(6, 6).copy() for k, s in self.cross.items()})
@@ -367,12 +355,12 @@ class DynamicsSlave(ArraySlave):
             v[part["position"]], v[part["attitude"]] = body.position, body.attitude
             v[part["velocity"]], v[part["acceleration"]] = body.velocity, acc
 
-    def advance(self, t, dt):
+    def step_physics(self, t, dt):
         if not self.check_finite(self.load_inputs):
             return
         loads = self._loads()
         rates = None
-        if self.config.get("load_hold") == "linear":
+        if self.config.load_hold == "linear":
             # first-order hold: extrapolate the load with its slope over the last step
             last = getattr(self, "last_loads", None)
             rates = np.zeros_like(loads) if last is None else (loads - last[0]) / last[1]
@@ -405,16 +393,16 @@ class ConnectorSlave(ArraySlave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         cfg = self.config
-        j = cfg["joint"]
-        node = LumpedBody("node", j["point_a"], **cfg["node"])
-        self.joint = BallJoint(cfg["name"], np.array(j["point_a"]), np.array(j["point_b"]), j["k_lin"], j["c_lin"],
-                               j["k_rot"], j["c_rot"], tuple(j["free"]), node, np.array(j["r_rel0"]))
-        self.explicit = cfg["accel_mode"] == "explicit"
+        j = cfg.joint
+        node = LumpedBody("node", j.point_a, **cfg.node)
+        self.joint = BallJoint(cfg.name, j.point_a, j.point_b, j.k_lin, j.c_lin, j.k_rot, j.c_rot, tuple(j.free),
+                               node, j.r_rel0)
+        self.explicit = cfg.accel_mode == "explicit"
         Out = Fmi2Causality.output
         accel = self.explicit and self.joint.uses_acceleration
-        self.side_a = self.add_motion("A.", cfg["a"]["position"], cfg["a"]["attitude"], accel, "side A")
-        self.side_b = (self.add_motion("B.", cfg["b"]["position"], cfg["b"]["attitude"], False, "side B")
-                       if cfg["b"] else None)
+        self.side_a = self.add_motion("A.", cfg.a.position, cfg.a.attitude, accel, "side A")
+        self.side_b = (self.add_motion("B.", cfg.b.position, cfg.b.attitude, False, "side B")
+                       if cfg.b is not None else None)
         inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
         self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,
                                        "load on side A, global axes, about A's reference point")

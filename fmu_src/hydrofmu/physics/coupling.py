@@ -26,43 +26,57 @@ from .memory import Convolution, StateSpace
 
 
 class Coupling:
-    """Loads of one hydrodynamic coupling (``decks.simo.CouplingData``).
+    """Loads of one hydrodynamic coupling between bodies A and B, from plain arrays.
 
-    method: 'convolution' (exact for piecewise-linear velocity, ``memory_length`` [s] may
-    truncate the kernels) or 'state_space' (kernels realised to normalised RMS error ≤ tol,
-    or at ``order``; see ``memory.realise``).  v0_a, v0_b: velocities at the start.
+    added_mass: A∞ (6×6, ``added_mass[i−1, j−1]`` couples dof i of A with dof j of B)
+    [kg, kg·m, kg·m²]; timdel [s]: kernel sample spacing (None without kernels); kernels:
+    {(IDOF_A, IDOF_B): samples at s = 0, TIMDEL, …} (1-based).  ``own``: self-coupling
+    (A is B: only side 'A').  method: 'convolution' (exact for piecewise-linear velocity,
+    ``memory_length`` [s] may truncate the kernels) or 'state_space' (kernels realised to
+    normalised RMS error ≤ tol, or at ``order``; see ``memory.realise``; ``fits``: stored
+    {(IDOF_A, IDOF_B): Realisation} to use instead).  v0_a, v0_b: velocities at the start.
+    ``name``, ``bodies``: labels (the names ``target``/``source`` return).
 
-    ``memory[side]``: the retardation evaluator of that side; ``advance(dt, v_source)`` on it
-    returns the memory load at the new time (see ``memory``).  ``fits``: for 'state_space',
-    {(IDOF_A, IDOF_B): Realisation} (order, error) shared by both sides.
+    ``memory[side]``: the retardation evaluator of that side: ``advance(dt, v_source)`` moves
+    it by dt [s] to the source body's new velocity and returns the memory load −∫ h·v at the
+    new time [N, N·m] (the one stepping signature, see ``memory``).  ``fits``: for 'state_space', {(IDOF_A, IDOF_B): Realisation} (order, error)
+    shared by both sides.
     """
 
-    def __init__(self, data, method="convolution", tol=0.01, order=None, memory_length=None,
-                 v0_a=None, v0_b=None):
-        self.name, self.body_a, self.body_b = data.name, data.body_a, data.body_b
-        self.self_coupling = data.body_a == data.body_b
-        self.sides = ("A",) if self.self_coupling else ("A", "B")
-        am = np.array(data.added_mass, float).reshape(6, 6)
+    def __init__(self, added_mass, timdel=None, kernels=None, method="convolution", tol=0.01, order=None,
+                 memory_length=None, v0_a=None, v0_b=None, *, own=False, name="", bodies=("A", "B"), fits=None):
+        self.name, (self.body_a, self.body_b) = name, bodies
+        self.self_coupling = own
+        self.sides = ("A",) if own else ("A", "B")
+        am = np.array(added_mass, float).reshape(6, 6)
         self._mass = {"A": am, "B": am.T.copy()}
-        k_a = {(i - 1, j - 1): np.asarray(h, float) for (i, j), h in data.kernels.items()}
+        k_a = {(i - 1, j - 1): np.asarray(h, float) for (i, j), h in (kernels or {}).items()}
         kernels = {"A": k_a, "B": {(j, i): h for (i, j), h in k_a.items()}}   # hᵀ for side B
-        v0 = {"A": v0_a if self.self_coupling else v0_b, "B": v0_a}
+        v0 = {"A": v0_a if own else v0_b, "B": v0_a}
         self.fits = {}
         self.memory = {}
         if method == "convolution":
             for s in self.sides:
-                self.memory[s] = Convolution(kernels[s], data.timdel, shape=(6, 6), v0=v0[s],
+                self.memory[s] = Convolution(kernels[s], timdel, shape=(6, 6), v0=v0[s],
                                              memory_length=memory_length)
         elif method == "state_space":
-            a = StateSpace(k_a, data.timdel, shape=(6, 6), v0=v0["A"], tol=tol, order=order,
-                           memory_length=memory_length)
+            stored = {(i - 1, j - 1): f for (i, j), f in (fits or {}).items()} or None
+            a = StateSpace(k_a, timdel, shape=(6, 6), v0=v0["A"], tol=tol, order=order,
+                           memory_length=memory_length, fits=stored)
             self.memory["A"] = a
             self.fits = {(i + 1, j + 1): f for (i, j), f in a.fits.items()}
             if "B" in self.sides:                  # the same realisations, transposed
-                self.memory["B"] = StateSpace(kernels["B"], data.timdel, shape=(6, 6), v0=v0["B"],
+                self.memory["B"] = StateSpace(kernels["B"], timdel, shape=(6, 6), v0=v0["B"],
                                               fits={(j, i): f for (i, j), f in a.fits.items()})
         else:
             raise ValueError(f"method must be 'convolution' or 'state_space', not {method!r}")
+
+    @classmethod
+    def from_deck(cls, data, *args, **kwargs):
+        """The coupling of a deck record (``decks.simo.CouplingData``); further arguments as
+        for the constructor."""
+        return cls(data.added_mass, data.timdel, data.kernels, *args, own=data.body_a == data.body_b,
+                   name=data.name, bodies=(data.body_a, data.body_b), **kwargs)
 
     def _side(self, side):
         if side not in self.sides:
@@ -85,11 +99,6 @@ class Coupling:
     def acceleration_load(self, side, a_source):
         """−mass(side)·a_source [N, N·m] (explicit mode)."""
         return -self._mass[self._side(side)] @ np.asarray(a_source, float)
-
-    def advance(self, side, dt, v_source):
-        """Advance that side's memory by dt [s] with the source body's new velocity; return
-        the memory load −∫ h·v at the new time [N, N·m]."""
-        return self.memory[self._side(side)].advance(dt, v_source)
 
     def state(self):
         """Everything needed to continue exactly (plain lists per side)."""
