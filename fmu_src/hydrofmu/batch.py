@@ -215,10 +215,13 @@ class Variants:
             if vid not in self.builds:
                 self.builds[vid] = Variant(vid, folder, None, _variables(folder))
             return Variant(vid, folder, run, self.builds[vid].variables)
-        from .fmi.build import build_scene, fmu_specs
+        from .assembly import assemble
+        from .description import to_plain
+        from .fmi.build import build_scene
         try:
             scene = self.scene(overrides)
-            vid = _digest([self.runtime, fmu_specs(scene)[0]])
+            vid = _digest([self.runtime, [[i.name, i.model_id, i.motion, i.forces, to_plain(i.fmu)]
+                                          for i in assemble(scene).instances]])
         except InputError as exc:
             return Variant(error=str(exc))
         run = {k: scene.run[k] for k in ("step", "stop", "algorithm")}
