@@ -7,7 +7,8 @@ them from a scene, ``fmi.build`` writes them with ``dump`` and the slaves read t
 the type hints (arrays as nested lists, nested dataclasses as tables), nothing else.
 
 Units and frames are the scene's (SI, global axes, loads about the body's reference point).
-This module needs numpy only: the FMU runtime imports it at instantiation.
+This module needs numpy only (with the coupling kernels it builds): the FMU runtime imports
+it at instantiation.
 """
 from __future__ import annotations
 
@@ -18,6 +19,9 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 
 import numpy as np
+
+from .physics.coupling import Coupling
+from .physics.memory import Realisation
 
 FILE = "hydrofmu.json"   # the description's name in the FMU's resources
 
@@ -88,8 +92,6 @@ class HydroCoupling:
     def model(self, v0_a=None, v0_b=None):
         """The physics.coupling.Coupling of this coupling with its evaluator settings
         (v0_a, v0_b: the bodies' velocities at the start)."""
-        from .physics.coupling import Coupling
-        from .physics.memory import Realisation
         return Coupling(self.added_mass, self.timdel, {(k.dof_a, k.dof_b): k.values for k in self.kernels},
                         self.method, self.tolerance, self.order, self.memory_length, v0_a=v0_a, v0_b=v0_b,
                         own=self.a == self.b, name=self.name, bodies=(self.a, self.b),
