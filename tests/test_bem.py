@@ -96,6 +96,42 @@ def test_wamit_file_read_back_exactly(tmp_path):
     assert read_bem(f, ulen, rho).kind == "WAMIT"
 
 
+def test_wamit_scene_gives_the_capytaine_couplings(tmp_path):
+    """The cylinders' dataset written by hand as a nondimensional WAMIT .1 (ULEN = 2 m, bodies
+    as WAMIT bodies 1 and 2): the scene's couplings equal those of the .nc route."""
+    ds = xr.load_dataset(CYL)
+    names = [f"cyl{b}__{d}" for b in (1, 2) for d in DOFS]
+    ulen, rho = 2.0, 1025.0
+    lines = []
+    for w in ds.omega.values[::-1]:
+        per = 0.0 if np.isinf(w) else 2 * np.pi / w
+        am = ds.added_mass.sel(omega=w).sel(influenced_dof=names, radiating_dof=names).values
+        bm = ds.radiation_damping.sel(omega=w).sel(influenced_dof=names, radiating_dof=names).values
+        for i in range(12):
+            for j in range(12):
+                s = rho * ulen ** (3 + (i % 6 >= 3) + (j % 6 >= 3))
+                lines.append(f"{per:.17E} {i + 1} {j + 1} {am[i, j] / s:.17E}"
+                             + ("" if np.isinf(w) else f" {bm[i, j] / (s * w):.17E}"))
+    (tmp_path / "cyl.1").write_text("\n".join(lines) + "\n")
+    wamit = load_scene(write_scene(tmp_path, bodies_text() + f"""
+        [[couplings]]
+        bem = "cyl.1"
+        ulen = {ulen}
+        bodies = {{ body1 = "a", body2 = "b" }}
+        kernel_length = 30.0
+        """, "w.toml"))
+    nc = load_scene(write_scene(tmp_path, bodies_text() + bem_text(extra="kernel_length = 30.0"), "nc.toml"))
+    for cw, cn in zip(wamit.couplings, nc.couplings):
+        assert (cw.name, cw.a, cw.b) == (cn.name, cn.a, cn.b)
+        assert cw.data["timdel"] == pytest.approx(cn.data["timdel"], rel=1e-12)
+        np.testing.assert_allclose(cw.data["added_mass"], cn.data["added_mass"], rtol=1e-9, atol=1e-6)
+        kw = {(i, j): h for i, j, h in cw.data["kernels"]}
+        kn = {(i, j): h for i, j, h in cn.data["kernels"]}
+        assert kw.keys() == kn.keys()
+        for key in kn:
+            np.testing.assert_allclose(kw[key], kn[key], rtol=0, atol=1e-9 * np.abs(kn[key]).max())
+
+
 @pytest.mark.parametrize("text, field", [
     ("0.5 1 1 2.0\n", "B"),                   # damping missing at a finite period
     ("0.5 1 x 2.0 1.0\n", "J"),

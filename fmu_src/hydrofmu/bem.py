@@ -38,6 +38,14 @@ class BemCouplings:
         r = self.radiation
         lines = [f"BEM {self.data.kind} {self.data.path}: {len(self.labels)} dofs, {r.omega.size} frequencies "
                  f"{r.omega[0]:g}…{r.omega[-1]:g} rad/s, transform {r.seconds:.2f} s"]
+        d = self.data
+        env = ", ".join(f"{k} {v:g}" for k, v in (("rho", d.rho), ("g", d.g), ("water depth", d.water_depth))
+                        if v is not None)
+        centres = [b for b in self.names if b in d.rotation_centers]
+        lines.append(f"  {env or 'no rho, g or depth in the file (the scene rho makes it dimensional)'}; "
+                     + ("rotation centres (the scene's reference points, checked) "
+                        + ", ".join(f"{b} {[float(x) for x in d.rotation_centers[b]]} m" for b in centres)
+                        if centres else "rotation centres not in the file: the scene's reference points assumed"))
         lines += [f"  {n}" for n in r.notes]
         if r.asymmetry:
             lines.append(f"  A∞ symmetrised (largest asymmetry {100 * r.asymmetry:.3g} % of √(A_ii·A_jj))")

@@ -129,7 +129,7 @@ def main(argv=None):
     d.add_argument("--scene", action="append", help="run only this scene (repeatable)")
     k = sub.add_parser("bench", help="speed/accuracy benchmarks and the stability map: CSV + PNG per part")
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path)
-    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability"),
+    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability", "bem"),
                    help="run only this part (repeatable)")
     k.add_argument("--quick", action="store_true", help="small sizes: a smoke run, not the README figures")
     m = sub.add_parser("bem2simo", help="SIMO coupling deck (A∞ and retardation functions) from a BEM result")

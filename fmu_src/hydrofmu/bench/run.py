@@ -9,6 +9,7 @@ Parts (each also callable alone, see ``PARTS``):
 - floor: startup and cost per step of every scene of models/ and of 2, 4, 8 coupled bodies,
   as multiples of the pythonfmu floor (``floor``), with the targets and a noise verdict
 - stability: added-mass stability map, explicit against export (``stability``)
+- bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 
 ``quick`` shrinks every part (for a smoke run); the figures in the README come from a full run.
 """
@@ -21,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from . import cosim_cost, floor, memory_cost, overhead, stability  # noqa: E402
+from . import cosim_cost, floor, memory_cost, overhead, radiation_cost, stability  # noqa: E402
 
 
 def write_csv(path, rows):
@@ -174,8 +175,16 @@ def part_stability(out, quick):
     return [f"added-mass map: {csv_path.name}, {png.name}"]
 
 
+def part_bem(out, quick):
+    sizes = ((12, 50), (12, 100)) if quick else ((12, 50), (12, 100), (12, 200), (24, 100))
+    rows = radiation_cost.measure(sizes, rounds=3 if quick else 5)
+    write_csv(out / "bem_transform.csv", rows)
+    return [f"BEM transform, {r['dofs']} dofs × {r['frequencies']} frequencies: {r['seconds']:.2f} s "
+            f"(×{r['ratio']:.2f} of the first)" for r in rows]
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
-         "floor": part_floor, "stability": part_stability}
+         "floor": part_floor, "stability": part_stability, "bem": part_bem}
 
 
 def main(out, parts=None, quick=False, log=print):

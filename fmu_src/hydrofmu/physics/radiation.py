@@ -16,8 +16,9 @@ between samples, zero after the last).  Method (stated in the README):
   segment), so K carries no quadrature error of its own.
 - TIMDEL = π/(TIMDEL_FACTOR·ω_N) unless asked; an asked TIMDEL above π/(TIMDEL_LIMIT·ω_N) cannot
   represent the grid's highest frequencies and is refused.
-- Kernel length: the time after which every kept |K_ij| stays below DECAY of its peak (capped
-  at the 2π/Δω the grid's spacing resolves), unless asked.
+- Kernel length: the shortest whose cut changes no rebuilt A(ω), B(ω) at the grid frequencies
+  by more than DECAY of the curve's peak (searched up to the 2π/Δω the grid's spacing
+  resolves), unless asked.
 - A∞: the file's infinite-frequency value when given; else Ogilvie's relation
   A∞ = A(ω) + (1/ω)·∫₀^L K(t)·sin(ωt) dt averaged over the top third of the grid.
 - Symmetry: A∞, A(ω) and B(ω) are symmetrised; an A∞ asymmetry |A_ij − A_ji| above
@@ -35,7 +36,7 @@ import numpy as np
 
 TIMDEL_FACTOR = 12.0     # default TIMDEL = π/(12·ω_N): 24 samples per period of ω_N
 TIMDEL_LIMIT = 8.0       # asked TIMDEL must be ≤ π/(8·ω_N)
-DECAY = 0.002            # kernel ends where every kept |K_ij| stays below 0.2 % of its peak
+DECAY = 0.002            # kernel ends where its cut changes no A(ω), B(ω) by more than 0.2 % of the peak
 P_MIN, P_MAX = 2.0, 8.0  # tail exponent bounds
 TAIL_SPAN = 50.0         # the tail is integrated up to 50·ω_N (its rest: (1/50)^(p−1) of it)
 TAIL_WARN = 0.05         # warn when the tail carries more than 5 % of ∫|B| dω
@@ -165,6 +166,35 @@ def _negligible(a, b, a_inf, units):
     return pairs & np.outer(on, on), scale_a
 
 
+def _decay_length(sampled, omega, a, b, active, timdel, cap, dw, warnings):
+    """The shortest kernel length L [s] whose cut changes no rebuilt A(ω) or B(ω) at the grid
+    frequencies by more than DECAY of that curve's peak: the parts ∫_L K(t)·cos ωt dt and
+    (1/ω)·∫_L K(t)·sin ωt dt (on a grid of 4·TIMDEL up to 2π/Δω) are small for every pair.
+    Measured in the frequency domain because A at low ω weighs the kernel's tail by t."""
+    t = 4 * timdel * np.arange(int(np.ceil(cap / (4 * timdel))) + 1)
+    pairs = np.argwhere(np.triu(active))
+    if not pairs.size:
+        return t[1]
+    k = sampled(t)[:, pairs[:, 0], pairs[:, 1]]                       # (nt, P)
+    worst = np.zeros(t.size)
+    for kind, db in (("cos", b), ("sin", a)):
+        w = hat_transform(t, omega, kind)
+        if kind == "sin":
+            w = w / omega[:, None]
+        part = np.cumsum((w[:, :, None] * k[None])[:, ::-1], axis=1)[:, ::-1]   # ∫ from t_m on
+        peak = np.max(np.abs(db[:, pairs[:, 0], pairs[:, 1]]), axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.where(peak > 0, np.abs(part) / peak, 0.0)
+        worst = np.maximum(worst, rel.max(axis=(0, 2)))
+    ok = np.nonzero(worst > DECAY)[0]
+    last = int(ok[-1]) + 1 if ok.size else 1
+    if last >= t.size - 1:
+        warnings.append(f"the kernels' tails still change A or B by more than {100 * DECAY:g} % of a peak at "
+                        f"2π/Δω = {cap:.4g} s, the longest memory the frequency spacing Δω = {dw:.4g} rad/s "
+                        f"resolves: refine the grid")
+    return t[min(last, t.size - 1)]
+
+
 def symmetrise(a_inf, scale, tol):
     """(A∞ + A∞ᵀ)/2 and the largest asymmetry ratio; AsymmetryError beyond ``tol``."""
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -234,19 +264,8 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
 
     def sampled(t):
         return (2 / np.pi) * (hat_transform(nodes, t) @ flat_b).reshape(t.size, n, n)
-    if length is None:   # find where the kernels have decayed on a coarser time grid first
-        t = 4 * timdel * np.arange(int(np.ceil(cap / (4 * timdel))) + 1)
-        k = sampled(t)
-        peak = np.max(np.abs(k), axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rel = np.where(active & (peak > 0), np.abs(k) / peak, 0.0).max(axis=(1, 2))
-        above = np.nonzero(rel > DECAY)[0]
-        last = int(above[-1]) + 1 if above.size else 1
-        if last >= t.size - 1:
-            warnings.append(f"the kernels have not decayed to {100 * DECAY:g} % of their peak within "
-                            f"2π/Δω = {cap:.4g} s, the longest memory the frequency spacing Δω = {dw:.4g} rad/s "
-                            f"resolves: refine the grid")
-        length = t[min(last, t.size - 1)]
+    if length is None:
+        length = _decay_length(sampled, omega, a, b, active, timdel, cap, dw, warnings)
     t = timdel * np.arange(int(np.ceil(length / timdel - 1e-9)) + 1)
     k = sampled(t)
     kernels = np.ascontiguousarray(k.transpose(1, 2, 0))
