@@ -312,7 +312,7 @@ def test_pitch_through_90_degrees_raises_gimbal_lock():
 
 @pytest.mark.parametrize("kwargs, field", [
     (dict(mass=-1.0), "mass"),
-    (dict(inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]), "inertia"),
+    (dict(inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]), "inertia[1,2]"),
     (dict(inertia=np.diag([1.0, -1.0, 1.0])), "inertia"),
     (dict(stiffness=np.zeros((3, 3))), "stiffness"),
     (dict(damping=np.full((6, 6), np.nan)), "damping"),

@@ -111,7 +111,7 @@ def fmu_growth(result, ratio):
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")   # the FMU runtime overflowing, in process
-def test_fmu_explicit_added_mass(tmp_path, capfd):
+def test_fmu_explicit_added_mass(tmp_path):
     """A/M = 0.5 bounded, A/M = 2 diverges: through the FMUs and the fmpy master, equal to
     the in-process run; a long diverging run ends in fmi2Error on a non-finite input."""
     low = run(build(tmp_path / "low", point_scene("am_low", 0.5, "explicit")), progress=False)
@@ -122,11 +122,8 @@ def test_fmu_explicit_added_mass(tmp_path, capfd):
     g = fmu_growth(run(folder, stop=5.0, progress=False), 2.0)
     assert g > 1e3
     assert g == pytest.approx(st.added_mass_run(2.0, 0.1, "explicit", n_steps=50), rel=1e-6)
-    capfd.readouterr()
-    with pytest.raises(Exception, match=r"fmi2DoStep failed .*\(error\)"):
+    with pytest.raises(Exception, match=r"fmi2DoStep failed .*\(error\).* is not finite"):
         run(folder, stop=100.0, progress=False)
-    out = capfd.readouterr()
-    assert "is not finite" in out.out + out.err
 
 
 def test_fmu_export_large_added_mass(tmp_path):
@@ -233,7 +230,7 @@ def pair_scene(tmp_path, cross_sway, step=0.01, stop=10.0):
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
-def test_cross_fmu_pair(tmp_path, capfd):
+def test_cross_fmu_pair(tmp_path):
     """Two equal bodies, explicit sway cross added mass c, 2 % damping, h = 10 ms:
     ρ(G) = c²/M² = 0.64 stays bounded over 10 s, 1.44 diverges."""
     x_free = 1.0 / OMEGA
@@ -252,7 +249,7 @@ def test_cross_fmu_pair(tmp_path, capfd):
         assert grown > 1e3
     except Exception as exc:         # overflow to a non-finite input: the FMU reports fmi2Error
         assert "fmi2DoStep" in str(exc)
-        assert "not finite" in "".join(capfd.readouterr())
+        assert "not finite" in str(exc)           # the FMU's log line, in the one RunError
 
 
 # -- 3. quadratic drag ----------------------------------------------------------------
@@ -360,7 +357,7 @@ def hand_drag(w0, kh, n, algorithm):
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 @pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
-def test_drag_fmu_pair(tmp_path, algorithm, capfd):
+def test_drag_fmu_pair(tmp_path, algorithm):
     """AQWA RELATIVE drag, current 2 m/s, v0 = −98 m/s (|u − v0| = 100 m/s), c = 1e4,
     M = 1e6 through the FMUs: at 0.8× the limit the run is the hand map and decays, at
     1.25× it diverges (overflow ends in fmi2Error)."""
@@ -377,4 +374,4 @@ def test_drag_fmu_pair(tmp_path, algorithm, capfd):
         assert np.abs(2.0 - r["hull_dynamics.velocity[1]"]).max() > 1e3 * 100.0
     except Exception as exc:
         assert "fmi2DoStep" in str(exc)
-        assert "not finite" in "".join(capfd.readouterr())
+        assert "not finite" in str(exc)           # the FMU's log line, in the one RunError

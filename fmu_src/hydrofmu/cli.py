@@ -1,11 +1,14 @@
 """Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer over the library)."""
 import argparse
 import json
+import math
+import os
 import sys
+import warnings
 from pathlib import Path
 
 from .cosim.master import describe
-from .errors import InputError
+from .errors import InputError, InputWarning
 
 DEFAULT_OUT = Path("build") / "fmus"
 
@@ -26,11 +29,31 @@ def build(paths, outdir=DEFAULT_OUT, log=print):
     from .scene import load_scene
 
     scenes = [load_scene(p) for p in paths]  # all validated before anything is written
+    names = {}
+    for scene in scenes:
+        if scene.name in names:
+            raise InputError(scene.path, None, "scene.name", f"{scene.name!r} is also the name of "
+                                                             f"{names[scene.name]}: each scene builds into its own folder")
+        names[scene.name] = scene.path
     return {s.name: build_scene(s, outdir, log=log) for s in scenes}
+
+
+def check_run(folder=None, csv=None, png=None, step=None, stop=None):
+    """Bad run arguments as one InputError, before anything is built or written."""
+    for key, value in (("step", step), ("stop", stop)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise InputError("command line", None, f"--{key}", f"must be a positive finite number, found {value:g}")
+    for out in (csv, png):
+        if out is not None and not Path(out).parent.is_dir():
+            raise InputError(out, None, "output file", f"folder {Path(out).parent} does not exist")
+    if folder is not None and not (Path(folder) / "manifest.json").is_file():
+        raise InputError(folder, None, "scene", "not a scene .toml nor a built scene folder (no manifest.json)")
 
 
 def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim; write CSV/PNG."""
+    folder = Path(folder)
+    check_run(folder, csv, png, kw.get("step"), kw.get("stop"))
     if engine == "libcosim":
         from .cosim.libcosim import run
     else:
@@ -99,6 +122,36 @@ def batch(args):
 
 
 def main(argv=None):
+    """The command line; returns the exit code: 0 done, 1 a run or validation failed,
+    2 bad input (one ``error:`` line naming the file, line or key path and field),
+    3 an internal error (one line; HYDROFMU_DEBUG=1 shows the traceback)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", InputWarning)
+        warnings.showwarning = _show_warning
+        try:
+            return _main(argv)
+        except InputError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
+        except RuntimeError as exc:   # a run that failed: RunError (fmpy) or libcosim stopping
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+        except Exception as exc:
+            if os.environ.get("HYDROFMU_DEBUG"):
+                raise
+            print(f"error: internal error ({type(exc).__name__}: {exc}); please report it "
+                  "(HYDROFMU_DEBUG=1 shows the traceback)", file=sys.stderr)
+            return 3
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    if issubclass(category, InputWarning):
+        print(f"warning: {message}", file=sys.stderr)
+    else:
+        print(f"warning: {category.__name__}: {message}", file=sys.stderr)
+
+
+def _main(argv):
     parser = argparse.ArgumentParser(prog="hydrofmu", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     b = sub.add_parser("build", help="build the FMUs of scenes (default: every scene in models/)")
@@ -143,36 +196,37 @@ def main(argv=None):
     m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     args = parser.parse_args(argv)
-    try:
-        if args.command == "build":
-            build(scenes_in(args.scenes), args.out)
-        elif args.command == "validate":
-            return 1 if validate(args.paths) else 0
-        elif args.command == "run":
-            folder = Path(args.scene)
-            if folder.suffix == ".toml":
-                folder = next(iter(build([folder], args.out).values()))
-            result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
-                                algorithm=args.algorithm)
-            print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)})")
-        elif args.command == "batch":
-            return batch(args)
-        elif args.command == "demo":
-            folders = build(scenes_in([]), args.out)
-            for name in args.scene or folders:
-                csv, png = args.out / f"{name}.csv", args.out / f"{name}.png"
-                result = run_folder(folders[name], "fmpy", csv, png)
-                print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
-                      f"wrote {csv} and {png}")
-        elif args.command == "bem2simo":
-            bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
-                     args.symmetry_tolerance, args.png)
-        elif args.command == "bench":
-            from .bench.run import main as bench
-            bench(args.out, args.part, args.quick)
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    if args.command == "build":
+        build(scenes_in(args.scenes), args.out)
+    elif args.command == "validate":
+        return 1 if validate(args.paths) else 0
+    elif args.command == "run":
+        folder = Path(args.scene)
+        if folder.suffix == ".toml":
+            check_run(None, args.csv, args.png, args.step, args.stop)
+            folder = next(iter(build([folder], args.out).values()))
+        result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
+                            algorithm=args.algorithm)
+        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)})")
+    elif args.command == "batch":
+        return batch(args)
+    elif args.command == "demo":
+        folders = build(scenes_in([]), args.out)
+        unknown = [name for name in args.scene or [] if name not in folders]
+        if unknown:
+            raise InputError("command line", None, "--scene", f"no scene {unknown[0]!r} in models/ "
+                                                              f"(scenes: {', '.join(folders)})")
+        for name in args.scene or folders:
+            csv, png = args.out / f"{name}.csv", args.out / f"{name}.png"
+            result = run_folder(folders[name], "fmpy", csv, png)
+            print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
+                  f"wrote {csv} and {png}")
+    elif args.command == "bem2simo":
+        bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
+                 args.symmetry_tolerance, args.png)
+    elif args.command == "bench":
+        from .bench.run import main as bench
+        bench(args.out, args.part, args.quick)
     return 0
 
 

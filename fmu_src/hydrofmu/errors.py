@@ -13,3 +13,13 @@ class InputError(ValueError):
         self.path, self.line, self.field, self.message = str(path), line, field, message
         where = self.path if line is None else f"{self.path}:{line}"
         super().__init__(f"{where}: {field}: {message}")
+
+
+class InputWarning(UserWarning):
+    """Legal but suspicious input (e.g. a negative drag coefficient): same naming as
+    InputError; the build goes on, the CLI prints one ``warning:`` line."""
+
+    def __init__(self, path, line, field, message):
+        self.path, self.line, self.field, self.message = str(path), line, field, message
+        where = self.path if line is None else f"{self.path}:{line}"
+        super().__init__(f"{where}: {field}: {message}")

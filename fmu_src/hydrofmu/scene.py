@@ -7,13 +7,16 @@ comes inline or from a vendor deck (path relative to the scene file + the name o
 body/structure in the deck).  See the README for the full format.
 """
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from . import admissible
 from .description import Effect, HydroCoupling, Kernel
-from .errors import InputError
+from .errors import InputError, InputWarning
+from .textfile import read_text
 
 ACCEL_MODES = ("export", "explicit")
 
@@ -57,15 +60,38 @@ class Problems:
 
     def __init__(self, path):
         self.path, self.items = Path(path), []
+        self.decks = {}   # (deck path, reader, args) -> entries or the InputError: each deck read once
 
     def add(self, key, message):
         self.items.append((key, message))
 
+    def add_all(self, where, problems):
+        """Record the (field, message) problems of an admissibility check as ``where.field``."""
+        for name, message in problems:
+            self.add(f"{where}.{name}", message)
+
+    def warn(self, key, message):
+        warnings.warn(InputWarning(self.path, None, key, message))
+
     def raise_if_any(self):
         if self.items:
-            text = "; ".join(f"{k}: {m}" for k, m in self.items)
-            first = self.items[0][0]
-            raise InputError(self.path, None, first, text if len(self.items) > 1 else self.items[0][1])
+            (first, message), rest = self.items[0], self.items[1:]
+            raise InputError(self.path, None, first, "; ".join([message] + [f"{k}: {m}" for k, m in rest]))
+
+    def deck(self, path, where, reader, *args):
+        """``reader(path, *args)``, read once per scene; a deck error is recorded once
+        (under the key path ``where`` of its first use) and None returned."""
+        key = (str(path), reader, args)
+        if key not in self.decks:
+            try:
+                self.decks[key] = reader(path, *args)
+            except InputError as exc:
+                self.decks[key] = exc
+                if not any(isinstance(v, InputError) and str(v) == str(exc) for k, v in self.decks.items()
+                           if k != key):
+                    self.add(where, str(exc))
+        found = self.decks[key]
+        return None if isinstance(found, InputError) else found
 
     # typed getters: return a value or None after recording the problem
     def table(self, parent, key, where, required=True):
@@ -181,10 +207,8 @@ def _from_deck(problems, table, where, reader, name_key):
     name = problems.string(table, name_key, f"{where}.{name_key}")
     if path is None or name is None:
         return None, None
-    try:
-        entries = reader(path)
-    except InputError as exc:
-        problems.add(f"{where}.deck", str(exc))
+    entries = problems.deck(path, f"{where}.deck", reader)
+    if entries is None:
         return None, None
     if name not in entries:
         problems.add(f"{where}.{name_key}", f"{name!r} is not in {path.name} (it has: {', '.join(entries) or 'none'})")
@@ -205,6 +229,8 @@ def _aqwa_viscous_drag(problems, table, where):
     option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
     if matrix is None or option is None:
         return None
+    for k, message in admissible.negative_diagonal(matrix):
+        problems.warn(f"{where}.matrix[{k + 1},{k + 1}]", message)
     return {"matrix": matrix, "relative": option == "RELATIVE"}
 
 
@@ -333,7 +359,7 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
     if not isinstance(items, list):
         problems.add("couplings", "expected an array of tables ([[couplings]])")
         return []
-    out, names, read = [], set(), {}
+    out, names = [], set()
     for i, table in enumerate(items):
         where = f"couplings[{i}]"
         if not isinstance(table, dict):
@@ -358,13 +384,8 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         knobs = _memory_knobs(problems, table, where, memory)
         if path is None or name is None or knobs[0] is None:
             continue
-        try:
-            key = (str(path), frozenset(known))   # a deck holds many couplings: read it once
-            if key not in read:
-                read[key] = read_couplings(path, bodies=known)
-            decks = read[key]
-        except InputError as exc:
-            problems.add(f"{where}.deck", str(exc))
+        decks = problems.deck(path, f"{where}.deck", read_couplings, frozenset(known))
+        if decks is None:
             continue
         if name not in decks:
             problems.add(f"{where}.coupling", f"{name!r} is not in {path.name} (it has: {', '.join(decks) or 'none'})")
@@ -518,6 +539,8 @@ def _body(problems, name, table, where):
     problems.known_keys(table, where, BODY_KEYS)
     if not identifier(name):
         problems.add(where, "body name must start with a letter and hold only letters, digits and '_'")
+    elif name.endswith("_dynamics"):
+        problems.add(where, "body names ending in '_dynamics' are reserved for the dynamics FMUs")
     body = Body(
         name=name,
         position=problems.vector(table, "position", f"{where}.position", 3, [0.0, 0.0, 0.0]),
@@ -531,6 +554,10 @@ def _body(problems, name, table, where):
         accel_mode=problems.choice(table, "acceleration_loads", f"{where}.acceleration_loads",
                                    ACCEL_MODES, "export"),
     )
+    if body.inertia is not None:
+        problems.add_all(where, admissible.inertia(body.inertia))
+    if body.attitude is not None:
+        problems.add_all(where, admissible.attitude(body.attitude))
     effects = table.get("effects", [])
     if not isinstance(effects, list):
         problems.add(f"{where}.effects", "expected an array of tables ([[bodies.NAME.effects]])")
@@ -565,10 +592,7 @@ def load_scene(path, overrides=None):
     key path of every problem; returns a Scene whose effect data is ready for kernels.
     ``overrides``: {key path: value} replacing values of the file (``override``)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(path, None, "file", f"cannot read scene ({exc.strerror})") from None
+    text = read_text(path, "scene")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -29,6 +29,11 @@ from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2Ca
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
 
+class RunError(RuntimeError):
+    """An FMU call failed during a run: names the instance, the call, the time and the
+    FMU's own error messages."""
+
+
 @dataclass
 class Result:
     """Recorded run: ``time`` (n,) and ``values`` (n, m) for ``columns`` 'instance.variable'."""
@@ -94,6 +99,7 @@ class Instance:
 
     def __init__(self, name, fmu_path):
         self.name = name
+        self.errors = []   # error/fatal messages the FMU logged (they go into RunError)
         self.md = read_model_description(str(fmu_path))
         self.dir = extract(str(fmu_path))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
@@ -107,7 +113,11 @@ class Instance:
         self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+        try:
+            self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+        except Exception as exc:   # fmpy: "Failed to instantiate model"
+            raise RunError(f"{name}: cannot instantiate {Path(fmu_path).name} ({exc})"
+                           + (": " + "; ".join(self.errors) if self.errors else "")) from None
         # outputs that depend on inputs (no dependency list: assume they all do)
         self.feedthrough = any(u.dependencies is None or u.dependencies for u in self.md.outputs)
         # the stepping loop calls the C functions itself: fmpy's wrappers build the value
@@ -119,10 +129,12 @@ class Instance:
         self._step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
         self._get.restype = self._set.restype = self._step.restype = ctypes.c_int
 
-    @staticmethod
-    def _log(env, instance, status, category, message):
-        label = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")[status] if 0 <= status < 6 else status
+    def _log(self, env, instance, status, category, message):
         text = (message or b"").decode("utf-8", "replace").replace("%%", "%")
+        if status in (3, 4):   # error, fatal: reported once, in the RunError of the failed call
+            self.errors.append(text)
+            return
+        label = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")[status] if 0 <= status < 6 else status
         sys.stderr.write(f"[{label}] {text}\n")
 
     def outputs(self):
@@ -150,6 +162,8 @@ class Instance:
     def free(self):
         try:
             self.fmu.terminate()
+        except FMICallException:
+            pass   # a failed instance may refuse to terminate; it is freed all the same
         finally:
             self.fmu.freeInstance()
             shutil.rmtree(self.dir, ignore_errors=True)  # the extracted copy (batches run thousands)
@@ -303,6 +317,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     ``on_step``: called with the step count after each communication step (benchmarks).
     """
     system = System(folder, parameters)
+    t = 0.0
     try:
         cfg = system.manifest["run"]
         stop = cfg["stop"] if stop is None else stop
@@ -351,5 +366,17 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
             sys.stderr.write("\n")
         return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"],
                       run_settings(system.manifest, step, algorithm, stop))
+    except FMICallException as exc:
+        raise RunError(failure(system, exc, t)) from None
     finally:
         system.free()
+
+
+_STATUS = {1: "warning", 2: "discard", 3: "error", 4: "fatal"}
+
+
+def failure(system, exc, t):
+    """One line for a failed FMU call: the call, the time and what each FMU logged."""
+    logged = [f"{name}: {msg}" for name, inst in system.instances.items() for msg in inst.errors]
+    return f"{exc.function} failed at t = {t:g} s ({_STATUS.get(exc.status, exc.status)})" + (
+        ": " + "; ".join(logged) if logged else "")

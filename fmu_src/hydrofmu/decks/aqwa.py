@@ -40,11 +40,13 @@ Units: V_ij is a drag coefficient times a projected area (times lever arms for t
 rotational terms) such that F_i = −Σ_j V_ij·w_j·|w_j| with w in m/s and rad/s, F in N and
 N·m; the matrix acts in body axes, moments about the body's reference point.
 """
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..admissible import negative_diagonal
+from ..errors import InputError, InputWarning
 from .lines import fields, keyword_key, read_lines
 
 OPTIONS = ("ABSOLUTE", "RELATIVE")
@@ -209,10 +211,10 @@ def _read_matrix(block, i, lines, end, what):
             # Name the line where the row was expected (next keyword line), else the last row.
             at = block[i] if i < len(block) else (lines[end] if end < len(lines) else block[i - 1])
             raise at.error(names[0], f"{what}: expected 6 rows of the viscous drag matrix, found {r}")
-        values = fields(block[i], names)
-        for c, n in enumerate(names):
-            if not np.isfinite(values[n]):
-                raise block[i].error(n, f"expected a finite number, found {values[n]}")
-            matrix[r, c] = values[n]
+        values = fields(block[i], names)   # finite: checked by fields
+        matrix[r] = [values[n] for n in names]
         i += 1
+    for k, message in negative_diagonal(matrix):
+        row = block[i - 6 + k]
+        warnings.warn(InputWarning(row.path, row.number, f"V{k + 1}{k + 1}", f"{what}: {message}"))
     return matrix, i

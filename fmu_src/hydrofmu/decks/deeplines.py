@@ -98,7 +98,7 @@ def _read_block(head, block):
     if len(first.words) != 4:
         raise first.error("XC", f"first line must hold the 4 values XC YC ZC SURFC, found "
                                 f"{len(first.words)}; the ANGC CXC CYC CMZC rows start on the next line")
-    p = _finite(first, fields(first, ["XC", "YC", "ZC", "SURFC"]))
+    p = fields(first, ["XC", "YC", "ZC", "SURFC"])   # finite: checked by fields
     if p["SURFC"] <= 0:
         raise first.error("SURFC", f"reference surface must be > 0, found {p['SURFC']}")
     rows = block[1:]
@@ -113,7 +113,7 @@ def _read_block(head, block):
             field_ = names[min(len(row.words), 3)]
             raise row.error(field_, f"row {i + 1} must hold the 4 values ANGC CXC CYC CMZC, "
                                     f"found {len(row.words)}")
-        v = _finite(row, fields(row, names))
+        v = fields(row, names)
         table[i] = [v[n] for n in names]
         angle = table[i, 0]
         if not 0.0 <= angle <= 360.0:
@@ -145,9 +145,3 @@ def _name(head):
         raise head.error("NAME", f"structure name must have at most 8 characters, found {name!r} ({len(name)})")
     return name
 
-
-def _finite(line, values):
-    for k, v in values.items():
-        if not np.isfinite(v):
-            raise line.error(k, f"expected a finite number, found {v}")
-    return values

@@ -1,9 +1,12 @@
 """Line-level tools shared by the deck readers: numbered lines, keyword matching,
 typed fields with errors that name the file, the line and the field."""
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..admissible import finite_problem
 from ..errors import InputError
+from ..textfile import read_text
 
 
 @dataclass(frozen=True)
@@ -27,26 +30,23 @@ def read_lines(path, comment="'", continuation=None):
     ``continuation``: a trailing mark (e.g. ``&``) that joins a line with the next one.
     """
     path = Path(path)
-    try:
-        raw = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise InputError(path, None, "file", f"cannot read deck ({exc.strerror})") from None
+    raw = read_text(path, "deck").splitlines()
     comments = (comment,) if isinstance(comment, str) else tuple(comment or ())
-    out, pending = [], None
+    out, pending, first = [], [], None   # pending: pieces of a continued line (joined once: linear)
     for number, text in enumerate(raw, start=1):
         stripped = text.strip()
         if not stripped or (comments and stripped.startswith(comments)):
             continue
-        if pending is not None:
-            stripped = pending.text + " " + stripped
-            number = pending.number
-            pending = None
+        if not pending:
+            first = number
         if continuation and stripped.endswith(continuation):
-            pending = Line(str(path), number, stripped[: -len(continuation)].rstrip())
+            pending.append(stripped[: -len(continuation)].rstrip())
             continue
-        out.append(Line(str(path), number, stripped))
-    if pending is not None:
-        out.append(pending)
+        pending.append(stripped)
+        out.append(Line(str(path), first, " ".join(pending)))
+        pending = []
+    if pending:
+        out.append(Line(str(path), first, " ".join(pending)))
     return out
 
 
@@ -72,6 +72,9 @@ def fields(line, names, kind=float, defaults=None):
     kinds = kind if isinstance(kind, (list, tuple)) else [kind] * len(names)
     defaults = defaults or {}
     words = line.words
+    empty = _empty_field(line.text)
+    if empty is not None and empty < len(names):
+        raise line.error(names[empty], f"empty field between commas; expected {' '.join(names)}")
     if len(words) > len(names):
         raise line.error(names[-1], f"expected {len(names)} values ({' '.join(names)}), found {len(words)}")
     values = {}
@@ -85,19 +88,34 @@ def fields(line, names, kind=float, defaults=None):
     return values
 
 
+def _empty_field(text):
+    """Index of the first empty comma-separated field ('1, ,2' or ',1'), or None."""
+    if "," not in text:
+        return None
+    parts = text.split(",")
+    for k, part in enumerate(parts[:-1]):   # a trailing comma ends the list, it is no field
+        if not part.strip():
+            return sum(len(p.split()) for p in parts[:k])
+    return None
+
+
 def convert(line, name, word, typ):
-    """One word as ``typ`` (float, int or str), or an error naming the field."""
+    """One word as ``typ`` (float, int or str), or an error naming the field.  Numbers
+    must be finite: NaN, inf and overflowing values (1e400) are errors here, for every deck."""
     if typ is str:
         return word
     try:
-        if typ is int:
-            value = float(word)
+        value = float(word.replace("D", "E").replace("d", "e"))
+        if typ is int and math.isfinite(value):
             if value != int(value):
                 raise ValueError
             return int(value)
-        return float(word.replace("D", "E").replace("d", "e"))
     except ValueError:
         raise line.error(name, f"expected {'an integer' if typ is int else 'a number'}, found {word!r}") from None
+    problem = finite_problem(value)
+    if problem:
+        raise line.error(name, f"{problem} ({word!r})")
+    return value
 
 
 class Cursor:

@@ -37,6 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..admissible import symmetric
+from ..errors import InputError
+from ..textfile import read_text
 from .lines import Cursor, Line, convert, fields, is_keyword, read_lines
 
 GROUP = "HYDRodynamic COUPling DATA"
@@ -45,7 +48,6 @@ ADDED_MASS = "COUPled ADDEd MASS"
 RETARDATION = "COUPled RETArdation FUNCtion"
 ELEMENTS = "RETArdation ELEment DATA"
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([EeDd][+-]?\d+)?$")
-SYMMETRY_TOL = 1e-3   # self-coupling: max|AM − AMᵀ| ≤ SYMMETRY_TOL·max|AM|
 
 
 @dataclass
@@ -172,13 +174,24 @@ def _blocks(cur, data, head):
         if len(words) > n:
             raise _at(vl, n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
         try:
-            data.kernels[dofs] = np.array([float(w.replace("D", "E").replace("d", "e")) for w in words])
-        except ValueError:   # find the bad value and its physical line only now (_at reads the file)
-            for k, w in enumerate(words):
-                convert(_at(vl, k), f"RETij({k + 1})", w, float)
+            values = np.array([float(w.replace("D", "E").replace("d", "e")) for w in words])
+        except ValueError:
+            values = None
+        if values is None or not np.all(np.isfinite(values)):
+            # find the bad value, then its physical line (one pass over the file, only now)
+            k = next(k for k, w in enumerate(words) if _bad(w))
+            convert(_at(vl, k), f"RETij({k + 1})", words[k], float)
+        data.kernels[dofs] = values
     if not first:
         where = cur.peek() or head
         raise where.error("NRETij", f"expected at least one 'NRETij IDOF_A IDOF_B' block after {ELEMENTS!r}")
+
+
+def _bad(word):
+    try:
+        return not np.isfinite(float(word.replace("D", "E").replace("d", "e")))
+    except ValueError:
+        return True
 
 
 def _one_word(line, name, hint=""):
@@ -190,19 +203,16 @@ def _one_word(line, name, hint=""):
 
 def _check_symmetric(head, am):
     """A body's own added mass must be symmetric (the coupling applies it once, as given)."""
-    diff = np.abs(am - am.T)
-    if diff.max() > SYMMETRY_TOL * np.abs(am).max():
-        i, j = np.unravel_index(np.argmax(diff), diff.shape)
-        raise head.error(f"AM{i + 1}{j + 1}", f"self-coupling added mass must be symmetric: "
-                                              f"AM{i + 1}{j + 1} = {am[i, j]:g} but AM{j + 1}{i + 1} = {am[j, i]:g}")
+    for name, message in symmetric(am, lambda i, j: f"AM{i + 1}{j + 1}"):
+        raise head.error(name, f"self-coupling added mass {message}")
 
 
 def _at(line, index):
     """The line (as a Line with its physical number) that holds word ``index`` of a line
     joined from '&' continuations; read_lines keeps only the first line's number."""
     try:
-        raw = Path(line.path).read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError:
+        raw = read_text(line.path, "deck").splitlines()
+    except InputError:
         return line
     count = 0
     for number in range(line.number, len(raw) + 1):

@@ -22,6 +22,7 @@ from xml.etree import ElementTree as ET
 from xml.dom import minidom
 
 from . import model_description
+from ..errors import InputError
 from .ssp import write_ssp
 from .. import description
 from ..assembly import assemble, notes
@@ -154,16 +155,33 @@ def report_bem(scene, log, folder):
         log(f"  wrote {png.name}")
 
 
-def build_scene(scene, outdir, shim=True, log=print):
+def build_scene(scene, outdir, shim=True, log=print, check=False):
     """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
-    The folder is replaced only when the whole build succeeded."""
+    The folder is replaced only when the whole build succeeded.  ``check``: stop before
+    anything is written (every check of the build done), return None."""
     outdir = Path(outdir)
     target = outdir / scene.name
     system = assemble(scene)
     runtime = runtime_name()
     for line in notes(scene, system):
         log(line)
-    outdir.mkdir(parents=True, exist_ok=True)
+    if check:
+        return None
+    if outdir.exists() and not outdir.is_dir():
+        raise InputError(outdir, None, "output folder", "is a file, not a folder")
+    created = next((p for p in [outdir, *outdir.parents][::-1] if not p.exists()), None)
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        _build_into(scene, outdir, target, system, runtime, shim, log)
+    except OSError as exc:
+        raise InputError(exc.filename or outdir, None, "output folder", f"cannot write ({exc.strerror})") from None
+    finally:
+        if created is not None and not target.exists():
+            shutil.rmtree(created, ignore_errors=True)   # no empty folders left by a failed build
+    return target
+
+
+def _build_into(scene, outdir, target, system, runtime, shim, log):
     with tempfile.TemporaryDirectory(prefix=f".{scene.name}-", dir=outdir) as tmp:
         work = Path(tmp)
         slaves = {}
@@ -195,4 +213,3 @@ def build_scene(scene, outdir, shim=True, log=print):
             target.rename(old)
         result.rename(target)
         shutil.rmtree(old, ignore_errors=True)
-    return target

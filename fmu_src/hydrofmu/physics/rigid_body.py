@@ -67,6 +67,7 @@ import math
 
 import numpy as np
 
+from .. import admissible
 from ..errors import InputError
 from .state import Motion
 
@@ -237,10 +238,8 @@ class RigidBody:
         self.source = str(source)
         self.mass = self._scalar(mass, "mass")
         inertia = self._array(inertia, (3, 3), "inertia")
-        if not np.allclose(inertia, inertia.T, rtol=1e-12, atol=1e-12 * np.abs(inertia).max()):
-            raise self._error("inertia", "must be symmetric")
-        if np.linalg.eigvalsh(inertia).min() <= 0.0:
-            raise self._error("inertia", "must be positive definite")
+        for field, message in admissible.inertia(inertia):
+            raise self._error(field, message)
         self.inertia = inertia
         self.cog = self._array(cog, (3,), "cog")
         self.stiffness = self._array(stiffness, (6, 6), "stiffness")

@@ -1,0 +1,73 @@
+"""Is a number physically admissible?  One set of checks for every deck reader, the scene
+loader and the physics: each returns a list of (field, message) problems, empty when the
+values are fine, and the caller names the file and line (deck) or key path (scene).
+
+Conventions: inertia [kg·m²] about the CoG in body axes; added mass 6×6 [kg, kg·m,
+kg·m²]; attitude (roll, pitch, yaw) [rad], ZYX Euler angles.
+"""
+import math
+
+import numpy as np
+
+SYMMETRY_TOL = 1e-3      # |A_ij − A_ji| ≤ SYMMETRY_TOL·√(A_ii·A_jj): relative, unit-consistent
+TRIANGLE_TOL = 1e-9      # principal inertias: I_a ≤ (I_b + I_c)·(1 + TRIANGLE_TOL)
+POSE_COS_MIN = 1e-3      # |cos θ| of the initial pitch: ≥ this (|θ| ≤ 89.94°), away from gimbal lock
+
+
+def finite_problem(value):
+    """A message when ``value`` is not a finite number, else None."""
+    return None if math.isfinite(value) else f"expected a finite number, found {value}"
+
+
+def symmetric(a, label, tol=SYMMETRY_TOL):
+    """Symmetry of a square matrix by |a_ij − a_ji| ≤ tol·√(a_ii·a_jj) (each entry compared
+    with the diagonal entries of its own row and column, so mixed units never meet).
+    ``label(i, j)`` names entry (i, j) (0-based), e.g. ``lambda i, j: f'AM{i+1}{j+1}'``."""
+    a = np.asarray(a, dtype=float)
+    d = np.sqrt(np.abs(np.diag(a)))
+    excess = np.abs(a - a.T) - tol * np.outer(d, d)
+    if not np.any(excess > 0.0):
+        return []
+    i, j = np.unravel_index(np.argmax(excess), a.shape)
+    i, j = (i, j) if i < j else (j, i)
+    return [(label(i, j), f"must be symmetric: {label(i, j)} = {a[i, j]:g} but {label(j, i)} = "
+                          f"{a[j, i]:g} (allowed difference {tol:g}·√({label(i, i)}·{label(j, j)}) "
+                          f"= {tol * d[i] * d[j]:g})")]
+
+
+def inertia(matrix, field="inertia"):
+    """Inertia tensor about the CoG: symmetric, positive definite, principal values
+    within the triangle inequality (I_a ≤ I_b + I_c, equality for a flat plate)."""
+    i = np.asarray(matrix, dtype=float)
+    label = lambda r, c: f"{field}[{r + 1},{c + 1}]"
+    problems = symmetric(i, label)
+    if problems:
+        return problems
+    p = np.linalg.eigvalsh(0.5 * (i + i.T))
+    if p.min() <= 0.0:
+        return [(field, f"must be positive definite: principal inertias {_list(p)}")]
+    if p[2] > (p[0] + p[1]) * (1.0 + TRIANGLE_TOL):
+        return [(field, f"principal inertias {_list(p)} violate the triangle inequality "
+                        f"(largest {p[2]:g} > sum of the others {p[0] + p[1]:g}): no rigid body has them")]
+    return []
+
+
+def attitude(angles, field="attitude"):
+    """A pose away from the ZYX Euler-angle singularity (pitch ±90°)."""
+    theta = float(angles[1])
+    if abs(math.cos(theta)) < POSE_COS_MIN:
+        return [(field, f"pitch {math.degrees(theta):.4f}° is at the ZYX Euler-angle singularity "
+                        f"(±90°, gimbal lock): keep |cos(pitch)| ≥ {POSE_COS_MIN:g}")]
+    return []
+
+
+def negative_diagonal(matrix):
+    """Suspicious, not wrong: a negative diagonal drag coefficient feeds energy in.
+    Returns warnings [(index k of the diagonal entry, message)]."""
+    d = np.diag(np.asarray(matrix, dtype=float))
+    return [(k, f"negative diagonal drag coefficient {d[k]:g} puts energy into the body "
+                "(a drag diagonal is normally ≥ 0)") for k in np.flatnonzero(d < 0.0)]
+
+
+def _list(values):
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
