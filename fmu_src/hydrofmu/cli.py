@@ -23,8 +23,9 @@ def scenes_in(paths, models="models"):
     return found
 
 
-def build(paths, outdir=DEFAULT_OUT, log=print):
-    """Validate every scene first, then build each one; returns {scene name: folder}."""
+def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
+    """Validate every scene first, then build each one; returns {scene name: folder}
+    (``check``: every check of the build, nothing written; the folders are None)."""
     from .fmi.build import build_scene
     from .scene import load_scene
 
@@ -35,7 +36,7 @@ def build(paths, outdir=DEFAULT_OUT, log=print):
             raise InputError(scene.path, None, "scene.name", f"{scene.name!r} is also the name of "
                                                              f"{names[scene.name]}: each scene builds into its own folder")
         names[scene.name] = scene.path
-    return {s.name: build_scene(s, outdir, log=log) for s in scenes}
+    return {s.name: build_scene(s, outdir, log=log, check=check) for s in scenes}
 
 
 def check_run(folder=None, csv=None, png=None, step=None, stop=None):
@@ -157,6 +158,8 @@ def _main(argv):
     b = sub.add_parser("build", help="build the FMUs of scenes (default: every scene in models/)")
     b.add_argument("scenes", nargs="*")
     b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
+    b.add_argument("--check", action="store_true", help="check the scenes and their decks as the build does; "
+                                                         "write nothing")
     r = sub.add_parser("run", help="run a scene (a .toml is built first) or a built scene folder")
     r.add_argument("scene")
     r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
@@ -182,7 +185,8 @@ def _main(argv):
     d.add_argument("--scene", action="append", help="run only this scene (repeatable)")
     k = sub.add_parser("bench", help="speed/accuracy benchmarks and the stability map: CSV + PNG per part")
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path)
-    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability", "bem"),
+    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability", "bem",
+                                                           "errors"),
                    help="run only this part (repeatable)")
     k.add_argument("--quick", action="store_true", help="small sizes: a smoke run, not the README figures")
     m = sub.add_parser("bem2simo", help="SIMO coupling deck (A∞ and retardation functions) from a BEM result")
@@ -197,7 +201,9 @@ def _main(argv):
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     args = parser.parse_args(argv)
     if args.command == "build":
-        build(scenes_in(args.scenes), args.out)
+        for name in build(scenes_in(args.scenes), args.out, check=args.check):
+            if args.check:
+                print(f"checked {name}: ok")
     elif args.command == "validate":
         return 1 if validate(args.paths) else 0
     elif args.command == "run":

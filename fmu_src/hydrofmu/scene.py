@@ -110,8 +110,8 @@ class Problems:
         if value is None:
             self.add(where, "missing value")
             return None
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            self.add(where, f"expected a number, found {value!r}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not _finite(value):
+            self.add(where, f"expected a finite number, found {_short(value)}")
             return None
         if positive and value <= 0:
             self.add(where, f"must be positive, found {value}")
@@ -174,6 +174,9 @@ class Problems:
     def array(self, value, where):
         try:
             arr = np.array(value, dtype=float)
+        except OverflowError:
+            self.add(where, "contains a number too large for a float")
+            return None
         except (TypeError, ValueError):
             self.add(where, "expected numbers (ragged or non-numeric array)")
             return None
@@ -181,6 +184,18 @@ class Problems:
             self.add(where, "contains a non-finite number")
             return None
         return arr
+
+
+def _finite(value):
+    try:
+        return bool(np.isfinite(float(value)))
+    except OverflowError:   # a TOML integer of 400 digits
+        return False
+
+
+def _short(value):
+    text = repr(value)
+    return text if len(text) <= 40 else text[:20] + "…" + text[-8:]
 
 
 def identifier(name):

@@ -14,6 +14,7 @@ class Line:
     path: str
     number: int  # 1-based line number in the file (first line of a continued line)
     text: str
+    pieces: tuple = ()   # continued line: (physical line number, start in text) of each piece
 
     @property
     def words(self):
@@ -21,6 +22,17 @@ class Line:
 
     def error(self, field, message):
         return InputError(self.path, self.number, field, message)
+
+    def at_word(self, index):
+        """This line numbered as the physical line that holds word ``index`` (0-based) of
+        a continued line; one pass over the words before it (only on the error path)."""
+        count = 0
+        for k, (number, start) in enumerate(self.pieces):
+            end = self.pieces[k + 1][1] if k + 1 < len(self.pieces) else len(self.text)
+            count += len(self.text[start:end].replace(",", " ").split())
+            if count > index:
+                return Line(self.path, number, self.text)
+        return self
 
 
 def read_lines(path, comment="'", continuation=None):
@@ -32,22 +44,30 @@ def read_lines(path, comment="'", continuation=None):
     path = Path(path)
     raw = read_text(path, "deck").splitlines()
     comments = (comment,) if isinstance(comment, str) else tuple(comment or ())
-    out, pending, first = [], [], None   # pending: pieces of a continued line (joined once: linear)
+    out, pending = [], []   # pending: (number, text) pieces of a continued line, joined once: linear
     for number, text in enumerate(raw, start=1):
         stripped = text.strip()
         if not stripped or (comments and stripped.startswith(comments)):
             continue
-        if not pending:
-            first = number
         if continuation and stripped.endswith(continuation):
-            pending.append(stripped[: -len(continuation)].rstrip())
+            pending.append((number, stripped[: -len(continuation)].rstrip()))
             continue
-        pending.append(stripped)
-        out.append(Line(str(path), first, " ".join(pending)))
+        pending.append((number, stripped))
+        out.append(_joined(str(path), pending))
         pending = []
     if pending:
-        out.append(Line(str(path), first, " ".join(pending)))
+        out.append(_joined(str(path), pending))
     return out
+
+
+def _joined(path, pieces):
+    if len(pieces) == 1:
+        return Line(path, *pieces[0])
+    starts, at = [], 0
+    for number, text in pieces:
+        starts.append((number, at))
+        at += len(text) + 1
+    return Line(path, pieces[0][0], " ".join(text for _, text in pieces), tuple(starts))
 
 
 def keyword_key(text):

@@ -39,8 +39,7 @@ import numpy as np
 
 from ..admissible import symmetric
 from ..errors import InputError
-from ..textfile import read_text
-from .lines import Cursor, Line, convert, fields, is_keyword, read_lines
+from .lines import Cursor, convert, fields, is_keyword, read_lines
 
 GROUP = "HYDRodynamic COUPling DATA"
 BODY = "BODY DATA"
@@ -168,30 +167,36 @@ def _blocks(cur, data, head):
         vl = cur.next("RETij(1)")
         words = vl.words
         if len(words) < n:
-            raise _at(vl, len(words) - 1).error(
+            raise vl.at_word(len(words) - 1).error(
                 f"RETij({len(words) + 1})", f"NRETij = {n} but {len(words)} values given "
                                              f"(continue a long line with '&')")
         if len(words) > n:
-            raise _at(vl, n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
-        try:
-            values = np.array([float(w.replace("D", "E").replace("d", "e")) for w in words])
-        except ValueError:
-            values = None
-        if values is None or not np.all(np.isfinite(values)):
-            # find the bad value, then its physical line (one pass over the file, only now)
-            k = next(k for k, w in enumerate(words) if _bad(w))
-            convert(_at(vl, k), f"RETij({k + 1})", words[k], float)
-        data.kernels[dofs] = values
+            raise vl.at_word(n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
+        data.kernels[dofs] = _numbers(vl, words)
     if not first:
         where = cur.peek() or head
         raise where.error("NRETij", f"expected at least one 'NRETij IDOF_A IDOF_B' block after {ELEMENTS!r}")
 
 
-def _bad(word):
-    try:
-        return not np.isfinite(float(word.replace("D", "E").replace("d", "e")))
-    except ValueError:
-        return True
+def _numbers(line, words, chunk=4096):
+    """The words of a kernel line as floats, in chunks: on a bad word only its chunk is
+    looked at again, so the error path costs what the good one does (linear)."""
+    out = []
+    for k0 in range(0, len(words), chunk):
+        part = words[k0:k0 + chunk]
+        try:
+            values = np.array([float(w.replace("D", "E").replace("d", "e")) for w in part])
+            if np.all(np.isfinite(values)):
+                out.append(values)
+                continue
+        except ValueError:
+            pass
+        for k, w in enumerate(part, start=k0):
+            try:
+                convert(line, f"RETij({k + 1})", w, float)
+            except InputError:   # the bad word: again, naming its physical line
+                convert(line.at_word(k), f"RETij({k + 1})", w, float)
+    return np.concatenate(out) if out else np.zeros(0)
 
 
 def _one_word(line, name, hint=""):
@@ -205,25 +210,6 @@ def _check_symmetric(head, am):
     """A body's own added mass must be symmetric (the coupling applies it once, as given)."""
     for name, message in symmetric(am, lambda i, j: f"AM{i + 1}{j + 1}"):
         raise head.error(name, f"self-coupling added mass {message}")
-
-
-def _at(line, index):
-    """The line (as a Line with its physical number) that holds word ``index`` of a line
-    joined from '&' continuations; read_lines keeps only the first line's number."""
-    try:
-        raw = read_text(line.path, "deck").splitlines()
-    except InputError:
-        return line
-    count = 0
-    for number in range(line.number, len(raw) + 1):
-        text = raw[number - 1].strip()
-        if not text or text.startswith("'"):
-            continue
-        more = text.endswith("&")
-        count += len((text[:-1] if more else text).replace(",", " ").split())
-        if count > index or not more:
-            return Line(line.path, number, line.text)
-    return line
 
 
 def format_coupling(name, body_a, body_b, added_mass=None, kernels=None, timdel=None,

@@ -1,0 +1,54 @@
+"""Robustness figures: how long a deck reader takes to report one bad number near the end
+of a big deck, against reading the same deck without it (both ways linear, so the ratio
+should stay near 1 whatever the size)."""
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..decks.simo import format_coupling, read_couplings, write_couplings
+from ..errors import InputError
+
+
+def write_big_deck(path, megabytes):
+    """A SIMO self-coupling deck of ~``megabytes`` MB: one kernel continued over many lines."""
+    n = int(megabytes * 1e6 / 16.3)   # ~16.3 bytes per sample as written
+    h = 1e5 * np.exp(-np.arange(n) * 1e-6)
+    return write_couplings(path, [format_coupling("C", "A", "A", kernels={(1, 1): h}, timdel=0.1)])
+
+
+def spoil_near_end(path, bad="1.0x-02", out=None):
+    """A copy of the deck with its last-but-one number replaced by ``bad``; returns
+    (path, the 1-based line of the bad number)."""
+    text = Path(path).read_text()
+    lines = text.split("\n")
+    k = len(lines) - 2 if lines[-1] == "" else len(lines) - 1   # the deck's last line
+    words = lines[k].split()
+    words[-1] = bad
+    lines[k] = " ".join(words)
+    out = Path(out or Path(path).with_name("bad_" + Path(path).name))
+    out.write_text("\n".join(lines))
+    return out, k + 1
+
+
+def deck_error_time(folder, megabytes=50.0, rounds=2):
+    """Seconds to read a good deck and to report the bad number in the spoilt one (best
+    of ``rounds``, side by side); returns a dict with both, their ratio and the message."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    good = write_big_deck(folder / "big.sys", megabytes)
+    bad, line = spoil_near_end(good)
+    t_good = t_bad = float("inf")
+    message = None
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        read_couplings(good, {"A"})
+        t_good = min(t_good, time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        try:
+            read_couplings(bad, {"A"})
+        except InputError as exc:
+            message = exc
+        t_bad = min(t_bad, time.perf_counter() - t0)
+    return {"megabytes": good.stat().st_size / 1e6, "good_s": t_good, "bad_s": t_bad,
+            "ratio": t_bad / t_good, "error": message, "bad_line": line}
