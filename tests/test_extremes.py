@@ -39,7 +39,7 @@ NODE = dict(am=500.0, ae=0.2, icoo="GLOBAL", cd=np.array([50.0, 60.0, 70.0]))
 PA, PB, TOW_X = np.array([30.0, 0.0, 0.0]), np.array([-30.0, 0.0, 0.0]), 60.0
 K_LIN, C_LIN, K_ROT, C_ROT = 1e7, 1e6, 1e9, 1e8
 FREE = np.array([False, True, False])                            # codes 1 0 1
-TOW_M, TOW_I = 5.0e5, np.array([1e7, 2e7, 4e7])
+TOW_M, TOW_I = 5.0e5, np.array([2e7, 2e7, 4e7])   # principal inertias within the triangle inequality
 TIMDEL = 0.1
 SELF_C, SELF_L = 2.0e5, 2.0                                      # SELFC: h = c on [0, L], convolution
 AB_C, AB_A, AB_L = 3.0e5, 0.5, 20.0                              # AB: h = c·e^(−a·s) on [0, L], state space
