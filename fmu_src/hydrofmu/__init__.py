@@ -1,8 +1,63 @@
 """hydrofmu: hydrodynamic loads on floating bodies as FMI 2.0 co-simulation FMUs.
 
-Layout: ``physics`` (pure numpy kernels), ``decks`` (vendor input readers),
-``scene`` (scene files), ``fmi`` (FMU wrapping and building), ``cosim`` (masters).
-The package uses relative imports only, so a build can embed a renamed copy of it
-inside each FMU.
+Public API (imported on first use, so ``import hydrofmu`` stays cheap):
+
+- ``load_scene(path) -> Scene``: read and validate a scene file;
+- ``build(scene, out) -> Path``: build its FMUs into ``out/<scene name>/``;
+- ``run(scene_or_folder, stop=..., step=...) -> Result``: build if needed and run;
+- ``Result`` (``to_csv``, ``plot``, ``motion``, ``vector``) and ``read_csv``;
+- the physics: ``ViscousDrag`` (AQWA), ``CurrentPolar`` (DeepLines), ``LumpedBody``
+  (RIFLEX BODY), ``BallJoint`` (RIFLEX CONB), ``Coupling`` (SIMO), ``Convolution`` and
+  ``StateSpace`` (retardation memory), ``BodyLoads``, ``RigidBody``, ``CoupledBodies``,
+  ``Motion``, ``Env``; ``InputError`` for bad input.
+
+Layout: ``physics`` (pure numpy kernels), ``decks`` (vendor input readers), ``scene``
+(scene files), ``fmi`` (FMU wrapping and building), ``cosim`` (masters).  The package uses
+relative imports only, so a build can embed a renamed copy of it inside each FMU; this
+file imports nothing at load time, so the copy's start-up inside an FMU pays nothing for it.
 """
+from importlib import import_module
+from typing import TYPE_CHECKING
+
 __version__ = "0.1.0"
+
+# public name -> module (relative to the package) that defines it
+_WHERE = {
+    "load_scene": "scene", "Scene": "scene", "InputError": "errors",
+    "build": "api", "run": "api",
+    "Result": "cosim.result", "read_csv": "cosim.result",
+    "ViscousDrag": "physics.viscous_drag", "CurrentPolar": "physics.current_polar",
+    "LumpedBody": "physics.lumped", "BallJoint": "physics.joint", "Coupling": "physics.coupling",
+    "Convolution": "physics.memory", "StateSpace": "physics.memory", "BodyLoads": "physics.loads",
+    "RigidBody": "physics.rigid_body", "CoupledBodies": "physics.rigid_body",
+    "Motion": "physics.state", "Env": "physics.state",
+}
+__all__ = sorted(_WHERE) + ["__version__"]
+
+
+def __getattr__(name):
+    if name in _WHERE:
+        value = getattr(import_module(f".{_WHERE[name]}", __name__), name)
+        globals()[name] = value   # the next lookup is a plain attribute
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE))
+
+
+if TYPE_CHECKING:   # for type checkers and IDEs; never executed
+    from .api import build, run
+    from .cosim.result import Result, read_csv
+    from .errors import InputError
+    from .physics.coupling import Coupling
+    from .physics.current_polar import CurrentPolar
+    from .physics.joint import BallJoint
+    from .physics.loads import BodyLoads
+    from .physics.lumped import LumpedBody
+    from .physics.memory import Convolution, StateSpace
+    from .physics.rigid_body import CoupledBodies, RigidBody
+    from .physics.state import Env, Motion
+    from .physics.viscous_drag import ViscousDrag
+    from .scene import Scene, load_scene

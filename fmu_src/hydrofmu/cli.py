@@ -1,16 +1,15 @@
-"""Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer over the library)."""
+"""Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer
+over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
-import json
 import math
 import os
 import sys
 import warnings
 from pathlib import Path
 
+from .api import DEFAULT_OUT, outputs
 from .cosim.master import describe
 from .errors import InputError, InputWarning
-
-DEFAULT_OUT = Path("build") / "fmus"
 
 
 def scenes_in(paths, models="models"):
@@ -36,7 +35,12 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
             raise InputError(scene.path, None, "scene.name", f"{scene.name!r} is also the name of "
                                                              f"{names[scene.name]}: each scene builds into its own folder")
         names[scene.name] = scene.path
-    return {s.name: build_scene(s, outdir, log=log, check=check) for s in scenes}
+    folders = {}
+    for s in scenes:
+        folders[s.name] = build_scene(s, outdir, log=log, check=check)
+        if not check:
+            log(f"built scene {s.name}: FMUs, manifest.json and OspSystemStructure.xml in {folders[s.name]}")
+    return folders
 
 
 def check_run(folder=None, csv=None, png=None, step=None, stop=None):
@@ -63,8 +67,7 @@ def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
     if csv:
         result.to_csv(csv)
     if png:
-        from .cosim.report import plot
-        plot(result, json.loads((Path(folder) / "manifest.json").read_text()), png)
+        result.plot(png)
     return result
 
 
@@ -122,6 +125,105 @@ def batch(args):
     return 0 if counts.get("ok", 0) == len(table) else 1
 
 
+HELP = """\
+examples:
+  hydrofmu demo                              build and run every scene in models/
+  hydrofmu run models/moored_barge.toml      build one scene, run it, write CSV + PNG
+  hydrofmu run build/fmus/moored_barge --stop 60 --step 0.05
+  hydrofmu <command> --help                  the options of one command"""
+
+
+class Formatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Adds '(default: …)' to a help text that does not say its default already."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False) or "default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
+
+
+def make_parser():
+    """The argument parser, every option with its help text and default."""
+    fmt = Formatter
+    parser = argparse.ArgumentParser(
+        prog="hydrofmu", formatter_class=argparse.RawDescriptionHelpFormatter, epilog=HELP,
+        description="Hydrodynamic loads on floating bodies as FMI 2.0 co-simulation FMUs: build the FMUs "
+                    "of a scene, run it, check and benchmark them.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="command")
+    b = sub.add_parser("build", formatter_class=fmt, help="build the FMUs of scenes",
+                       description="Validate every scene, then build each one into OUT/<scene name>/: one load FMU "
+                                   "per body, joint FMUs, dynamics-partner FMUs, manifest.json (our masters) and "
+                                   "OspSystemStructure.xml (libcosim).  A build replaces the folder only when it "
+                                   "succeeded.")
+    b.add_argument("scenes", nargs="*", metavar="SCENE", help="scene files (.toml); none: every *.toml in models/")
+    b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="parent folder of the built scenes")
+    b.add_argument("--check", action="store_true", help="check the scenes and their decks as the build does; "
+                                                         "write nothing")
+    r = sub.add_parser("run", formatter_class=fmt, help="run a scene (a .toml is built first) or a built scene folder",
+                       description="Run a scene and write its results: the CSV (header 'instance.variable "
+                                   "[unit]', one row per communication point) and the PNG (motion from the initial "
+                                   "pose, every load, joint gaps) next to the built folder, <folder>.csv and "
+                                   "<folder>.png, unless --csv/--png say otherwise.  Step, stop and algorithm "
+                                   "default to the scene's [run] settings (its preset's).")
+    r.add_argument("scene", metavar="SCENE", help="scene file (.toml, built into OUT first) or built scene folder")
+    r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="where a .toml scene is built")
+    r.add_argument("--engine", choices=("fmpy", "libcosim"), default="fmpy",
+                   help="master: hydrofmu's fmpy master or libcosim (Jacobi only)")
+    r.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"),
+                   help="fmpy master algorithm (default: the scene's)")
+    r.add_argument("--step", type=float, metavar="S", help="communication step [s] (default: the scene's)")
+    r.add_argument("--stop", type=float, metavar="T", help="end time [s] (default: the scene's)")
+    r.add_argument("--csv", type=Path, metavar="FILE", help="CSV file to write (default: <folder>.csv)")
+    r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")
+    a = sub.add_parser("batch", formatter_class=fmt,
+                       description="Run a matrix of load cases (a case file: a scene and the values to vary) on Dask: one table of results (cases.csv, cases.parquet) and plots; exit code 1 when a case failed.",
+                       help="run a matrix of load cases (a case file) on Dask: one table, plots")
+    a.add_argument("cases", type=Path, help="case file (TOML, see the README's 'Load-case batches')")
+    a.add_argument("-o", "--out", type=Path, help="results folder (default build/batch/<case file name>)")
+    where = a.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="worker processes of the local Dask cluster (default: cores)")
+    where.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 "
+                                           "(the FMUs are shipped to its workers)")
+    a.add_argument("--series", action="store_true", help="write each case's time series (DIR/series/<case>.parquet)")
+    a.add_argument("--retry-failed", action="store_true", help="rerun the cases that failed in an earlier run")
+    v = sub.add_parser("validate", formatter_class=fmt, help="fmpy validation of built FMUs",
+                       description="fmpy's validation of FMU files, or of every FMU under folders; exit code 1 "
+                                   "when a problem is found.")
+    v.add_argument("paths", nargs="*", default=[str(DEFAULT_OUT)], metavar="PATH",
+                   help=f"FMU files or folders (default: {DEFAULT_OUT})")
+    d = sub.add_parser("demo", formatter_class=fmt,
+                       help="build every scene in models/, run each one, write CSV and PNG per scene",
+                       description="Build every scene in models/ into OUT, run each one with its own settings "
+                                   "and write OUT/<scene>.csv and OUT/<scene>.png.")
+    d.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="parent folder of the built scenes and results")
+    d.add_argument("--scene", action="append", metavar="NAME",
+                   help="run only this scene (repeatable; default: all)")
+    k = sub.add_parser("bench", formatter_class=fmt,
+                       help="speed/accuracy benchmarks and the stability map: CSV + PNG per part",
+                       description="Speed/accuracy benchmarks (timed side by side, reported as ratios) and the "
+                                   "added-mass stability map; CSV + PNG per part and summary.txt in OUT.  About "
+                                   "10 minutes in full.")
+    k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
+    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability", "bem", "errors"),
+                   help="run only this part (repeatable; default: all)")
+    k.add_argument("--quick", action="store_true", help="small sizes: a 1-minute smoke run, not the README figures")
+    m = sub.add_parser("bem2simo", formatter_class=fmt,
+                       help="SIMO coupling deck (A∞ and retardation functions) from a BEM result",
+                       description="Turn a BEM result (Capytaine NetCDF, WAMIT .1) into a SIMO deck with every self "
+                                   "and cross coupling of its bodies (A∞ and retardation functions), with the "
+                                   "transform's quality report.")
+    m.add_argument("result", type=Path, help="Capytaine dataset (.nc) or WAMIT .1 file")
+    m.add_argument("-o", "--out", required=True, type=Path, help="SIMO deck to write")
+    m.add_argument("--ulen", type=float, help="WAMIT: the length ULEN [m] of the nondimensional file")
+    m.add_argument("--rho", type=float, default=1025.0, help="WAMIT: density [kg/m3] (default 1025)")
+    m.add_argument("--dofs", nargs="+", help="dofs to keep, e.g. Surge Heave Pitch (default: all in the file)")
+    m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
+    m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")
+    m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
+    m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
+    return parser
+
+
 def main(argv=None):
     """The command line; returns the exit code: 0 done, 1 a run or validation failed,
     2 bad input (one ``error:`` line naming the file, line or key path and field),
@@ -153,53 +255,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 
 
 def _main(argv):
-    parser = argparse.ArgumentParser(prog="hydrofmu", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    b = sub.add_parser("build", help="build the FMUs of scenes (default: every scene in models/)")
-    b.add_argument("scenes", nargs="*")
-    b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
-    b.add_argument("--check", action="store_true", help="check the scenes and their decks as the build does; "
-                                                         "write nothing")
-    r = sub.add_parser("run", help="run a scene (a .toml is built first) or a built scene folder")
-    r.add_argument("scene")
-    r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
-    r.add_argument("--engine", choices=("fmpy", "libcosim"), default="fmpy")
-    r.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"))
-    r.add_argument("--step", type=float)
-    r.add_argument("--stop", type=float)
-    r.add_argument("--csv", type=Path)
-    r.add_argument("--png", type=Path)
-    a = sub.add_parser("batch", help="run a matrix of load cases (a case file) on Dask: one table, plots")
-    a.add_argument("cases", type=Path, help="case file (TOML, see the README's 'Load-case batches')")
-    a.add_argument("-o", "--out", type=Path, help="results folder (default build/batch/<case file name>)")
-    where = a.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, help="worker processes of the local Dask cluster (default: cores)")
-    where.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 "
-                                           "(the FMUs are shipped to its workers)")
-    a.add_argument("--series", action="store_true", help="write each case's time series (DIR/series/<case>.parquet)")
-    a.add_argument("--retry-failed", action="store_true", help="rerun the cases that failed in an earlier run")
-    v = sub.add_parser("validate", help="fmpy validation of built FMUs")
-    v.add_argument("paths", nargs="*", default=[str(DEFAULT_OUT)])
-    d = sub.add_parser("demo", help="build every scene in models/, run each one, write CSV and PNG per scene")
-    d.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path)
-    d.add_argument("--scene", action="append", help="run only this scene (repeatable)")
-    k = sub.add_parser("bench", help="speed/accuracy benchmarks and the stability map: CSV + PNG per part")
-    k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path)
-    k.add_argument("--part", action="append", choices=("overhead", "memory", "sweep", "growth", "floor", "stability", "bem",
-                                                           "errors"),
-                   help="run only this part (repeatable)")
-    k.add_argument("--quick", action="store_true", help="small sizes: a smoke run, not the README figures")
-    m = sub.add_parser("bem2simo", help="SIMO coupling deck (A∞ and retardation functions) from a BEM result")
-    m.add_argument("result", type=Path, help="Capytaine dataset (.nc) or WAMIT .1 file")
-    m.add_argument("-o", "--out", required=True, type=Path, help="SIMO deck to write")
-    m.add_argument("--ulen", type=float, help="WAMIT: the length ULEN [m] of the nondimensional file")
-    m.add_argument("--rho", type=float, default=1025.0, help="WAMIT: density [kg/m3] (default 1025)")
-    m.add_argument("--dofs", nargs="+", help="dofs to keep, e.g. Surge Heave Pitch (default: all in the file)")
-    m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
-    m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")
-    m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
-    m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
-    args = parser.parse_args(argv)
+    args = make_parser().parse_args(argv)
     if args.command == "build":
         for name in build(scenes_in(args.scenes), args.out, check=args.check):
             if args.check:
@@ -211,9 +267,12 @@ def _main(argv):
         if folder.suffix == ".toml":
             check_run(None, args.csv, args.png, args.step, args.stop)
             folder = next(iter(build([folder], args.out).values()))
-        result = run_folder(folder, args.engine, args.csv, args.png, stop=args.stop, step=args.step,
+        csv, png = outputs(folder)
+        csv, png = args.csv or csv, args.png or png
+        result = run_folder(folder, args.engine, csv, png, stop=args.stop, step=args.step,
                             algorithm=args.algorithm)
-        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)})")
+        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
+              f"wrote {csv} and {png}")
     elif args.command == "batch":
         return batch(args)
     elif args.command == "demo":
@@ -223,7 +282,7 @@ def _main(argv):
             raise InputError("command line", None, "--scene", f"no scene {unknown[0]!r} in models/ "
                                                               f"(scenes: {', '.join(folders)})")
         for name in args.scene or folders:
-            csv, png = args.out / f"{name}.csv", args.out / f"{name}.png"
+            csv, png = outputs(folders[name])
             result = run_folder(folders[name], "fmpy", csv, png)
             print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
                   f"wrote {csv} and {png}")

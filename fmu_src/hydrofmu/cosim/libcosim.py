@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .master import Result, run_settings
+from .master import run_settings
+from .result import Result, column_units
 
 NS = 1_000_000_000
 
@@ -70,7 +71,7 @@ def run(folder, stop=None, step=None, record=None, algorithm=None):
         name, var = col.split(".", 1)
         values[:, j] = _samples(series, index[name], refs[name][var], n)
     return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step, manifest["dynamics"],
-                  run_settings(manifest, step, "jacobi", stop))
+                  run_settings(manifest, step, "jacobi", stop), column_units(folder, manifest, record), manifest)
 
 
 def _samples(series, slave, ref, n):

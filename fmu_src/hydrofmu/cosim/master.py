@@ -13,12 +13,10 @@ Algorithms (communication step h, points t_k = k·h):
 Initialisation resolves the feedthrough: connections are transferred twice inside
 initialization mode, so at t = 0 every load output reflects the initial motion.
 """
-import csv
 import ctypes
 import shutil
 import sys
 import time as clock
-from dataclasses import dataclass
 from pathlib import Path
 import json
 
@@ -28,42 +26,12 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
+from .result import Result, column_units
+
 
 class RunError(RuntimeError):
     """An FMU call failed during a run: names the instance, the call, the time and the
     FMU's own error messages."""
-
-
-@dataclass
-class Result:
-    """Recorded run: ``time`` (n,) and ``values`` (n, m) for ``columns`` 'instance.variable'."""
-    time: np.ndarray
-    columns: list
-    values: np.ndarray
-    algorithm: str
-    step: float
-    dynamics: dict = None  # body -> [dynamics instance, variable prefix]
-    settings: dict = None  # preset and knobs of the run (``run_settings``)
-
-    def __getitem__(self, column):
-        return self.values[:, self.columns.index(column)]
-
-    def vector(self, instance, name, n):
-        """(n_times, n) array of instance.name[1..n]."""
-        return np.column_stack([self[f"{instance}.{name}[{i}]"] for i in range(1, n + 1)])
-
-    def motion(self, body, name, n):
-        """(n_times, n) array of a body's dynamics output name[1..n] (position, attitude,
-        velocity, acceleration), wherever the body's dynamics FMU is."""
-        instance, prefix = self.dynamics[body]
-        return self.vector(instance, f"{prefix}{name}", n)
-
-    def to_csv(self, path):
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["time"] + self.columns)
-            for t, row in zip(self.time, self.values):
-                w.writerow([repr(float(t))] + [repr(float(x)) for x in row])
 
 
 def run_settings(manifest, step=None, algorithm=None, stop=None):
@@ -365,7 +333,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         if progress and tty:
             sys.stderr.write("\n")
         return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"],
-                      run_settings(system.manifest, step, algorithm, stop))
+                      run_settings(system.manifest, step, algorithm, stop),
+                      column_units(system.folder, system.manifest, record), system.manifest)
     except FMICallException as exc:
         raise RunError(failure(system, exc, t)) from None
     finally:

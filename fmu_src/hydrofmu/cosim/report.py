@@ -1,44 +1,209 @@
-"""Plots of a run: motions of every body and the loads of every load FMU."""
+"""Plots of a run: per body, its motion from the initial pose and every load on it (forces
+and moments, one colour per effect in the whole figure); per joint, its gap, relative
+rotation and force.
+
+Data choices, kept in plain functions (tested on synthetic series):
+- motion is shown relative to the initial pose (`relative_motion`): a body moored at
+  x = 100 m moves by metres, which an absolute axis from 0 to 100 m hides;
+- load axes follow the settled part of the run (`robust_limits`): a start transient many
+  times larger than the rest is clipped, and the panel says so and gives its range.
+"""
 from pathlib import Path
+
+import numpy as np
+
+LINESTYLES = ("-", "--", ":")   # component x / y / z (Fx / Fy / Fz, Mx / My / Mz, roll / pitch / yaw)
+TOTAL = "total"
+
+
+def relative_motion(position, attitude):
+    """Translation [m] and rotation [rad] from the first sample.
+
+    Parameters
+    ----------
+    position : (n, 3) array
+        Reference-point position, global axes [m].
+    attitude : (n, 3) array
+        Roll, pitch, yaw [rad]; unwrapped in time first, so a yaw going through ±π
+        gives a continuous rotation.
+
+    Returns
+    -------
+    (n, 3) array, (n, 3) array
+        ``position - position[0]`` and ``unwrap(attitude) - attitude[0]``.
+    """
+    position, attitude = np.asarray(position, float), np.asarray(attitude, float)
+    return position - position[0], np.unwrap(attitude, axis=0) - attitude[0]
+
+
+def robust_limits(t, series, settle=0.1, q=1.0, factor=3.0, pad=0.1):
+    """Axis limits that a start transient does not set.
+
+    The spread of the settled run is the ``q``..``100 - q`` percentile range of every series
+    after ``t[0] + settle·(t[-1] - t[0])``.  If the whole data span is more than ``factor``
+    times that spread, the limits are the spread widened by ``pad`` of it on each side and
+    the data are clipped; otherwise the limits are the whole data span widened by ``pad``.
+
+    Parameters
+    ----------
+    t : (n,) array
+        Times [s].
+    series : sequence of (n,) arrays
+        The curves of one panel.
+    settle, q, factor, pad : float
+        Fraction of the run skipped as start, percentile [%], clipping threshold and
+        padding (fractions of the span).
+
+    Returns
+    -------
+    lo, hi : float
+        Axis limits.
+    clipped : tuple or None
+        ``(min, max)`` of all data when they exceed the limits, else None.
+    """
+    t = np.asarray(t, float)
+    data = np.array([np.asarray(s, float) for s in series])
+    data = data.reshape(len(data), -1)
+    finite = np.isfinite(data)
+    if not finite.any():
+        return -1.0, 1.0, None
+    lo_all, hi_all = float(data[finite].min()), float(data[finite].max())
+    late = data[:, t >= t[0] + settle * (t[-1] - t[0])]
+    late = late[np.isfinite(late)]
+    lo, hi = (np.percentile(late, [q, 100 - q]) if late.size else (lo_all, hi_all))
+    clip = hi_all - lo_all > factor * (hi - lo)
+    if not clip:
+        lo, hi = lo_all, hi_all
+    width = hi - lo
+    margin = pad * width if width > 0 else (0.1 * abs(hi) or 1.0)   # a flat line: ±10 %, or ±1 at 0
+    lo, hi = float(lo - margin), float(hi + margin)
+    return lo, hi, ((lo_all, hi_all) if clip and (lo_all < lo or hi_all > hi) else None)
+
+
+def effect_colours(names):
+    """One colour per effect name, the same in every panel: ``total`` black, the others
+    from matplotlib's tab10 cycle in sorted order."""
+    palette = ["C0", "C1", "C2", "C3", "C4", "C5", "C6", "C8", "C9", "C7"]
+    others = sorted(set(names) - {TOTAL})
+    out = {name: palette[i % len(palette)] for i, name in enumerate(others)}
+    out[TOTAL] = "black"
+    return out
+
+
+def joint_sides(manifest):
+    """Joint instance -> (body A, body B or None for the earth), from the manifest's
+    connections (side B's motion comes from B's dynamics)."""
+    by_dyn = {(inst, prefix): body for body, (inst, prefix) in manifest["dynamics"].items()}
+    sides = {}
+    for name, inst in manifest["instances"].items():
+        if inst["kind"] != "joint":
+            continue
+        b = None
+        for src, svar, dst, dvar in manifest["connections"]:
+            if dst == name and dvar.startswith("B.position"):
+                prefix = svar[:len(svar) - len("position[1]")]
+                b = by_dyn.get((src, prefix))
+        sides[name] = (inst["body"], b)
+    return sides
+
+
+def body_loads(result, manifest, body):
+    """Effect name -> (n, 6) load on ``body`` [N, N·m] (global axes, about its reference
+    point): every effect and coupling of its load FMU, each joint's force on it, and
+    ``total`` (their sum)."""
+    cols = set(result.columns)
+    loads = {}
+    for name, inst in manifest["instances"].items():
+        if inst["kind"] == "load" and inst["body"] == body:
+            groups = sorted({c[len(name) + 1:-len(".force[1]")] for c in cols
+                             if c.startswith(f"{name}.") and c.endswith(".force[1]")})
+            for g in filter(None, groups):   # "" is the load FMU's own total
+                loads[g] = result.vector(name, f"{g}.force", 6)
+    for joint, (a, b) in joint_sides(manifest).items():
+        for side, who in (("A", a), ("B", b)):
+            if who == body and f"{joint}.{side}.force[1]" in cols:
+                loads[joint] = result.vector(joint, f"{side}.force", 6)
+    if loads:
+        loads[TOTAL] = sum(loads.values())
+    return loads
+
+
+def _panel(ax, t, curves, title, colours, robust=True):
+    """Plot (effect, component, values) curves; limits from `robust_limits`."""
+    for effect, comp, y in curves:
+        ax.plot(t, y, color=colours.get(effect, "black"), ls=LINESTYLES[comp],
+                lw=2.0 if effect == TOTAL else 1.2)
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, alpha=0.3)
+    if curves and robust:
+        lo, hi, clipped = robust_limits(t, [y for _, _, y in curves])
+        ax.set_ylim(lo, hi)
+        if clipped:
+            ax.text(0.01, 0.02, f"axis clipped to the settled run; data span {clipped[0]:.3g} … {clipped[1]:.3g}",
+                    transform=ax.transAxes, fontsize=7, color="0.25",
+                    bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.85))
 
 
 def plot(result, manifest, path):
-    """Write a PNG: one row per body (motions: surge/sway/heave and roll/pitch/yaw; loads:
-    each effect's force and yaw moment)."""
+    """Write a PNG of a run.
+
+    Per body two rows: translation from the initial pose [m], horizontal forces Fx, Fy
+    and vertical force Fz [kN]; rotation from the initial pose [deg], yaw moment Mz and
+    roll/pitch moments Mx, My [kN·m] (global axes, about the reference point).  Per joint
+    one row: gap [mm], relative rotation [deg], force on side A [kN].  Colour = effect
+    (the same in every panel, ``total`` black), line style = component (x solid, y
+    dashed, z dotted).
+    """
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
+    from matplotlib.lines import Line2D
 
-    bodies = sorted(manifest["dynamics"])
-    fig, axes = plt.subplots(len(bodies), 3, figsize=(15, 3.6 * len(bodies)), squeeze=False)
     t = result.time
-    for row, body in zip(axes, bodies):
-        load = body
-        pos = result.motion(body, "position", 3)
-        att = np.degrees(result.motion(body, "attitude", 3))
-        for i, label in enumerate(("x", "y", "z")):
-            row[0].plot(t, pos[:, i], label=label)
-        row[0].set(title=f"{body}: position [m]", xlabel="time [s]")
-        for i, label in enumerate(("roll", "pitch", "yaw")):
-            row[1].plot(t, att[:, i], label=label)
-        row[1].set(title=f"{body}: attitude [deg]", xlabel="time [s]")
-        groups = sorted({c.split(".")[1] for c in result.columns
-                         if c.startswith(f"{load}.") and c.endswith("force[1]") and c.count(".") == 2})
-        for g in ["force"] + groups:
-            prefix = "force" if g == "force" else f"{g}.force"
-            try:
-                f = result.vector(load, prefix, 6)
-            except ValueError:
-                continue
-            lw = 2.0 if g == "force" else 1.0
-            row[2].plot(t, f[:, 0] / 1e3, lw=lw, label=f"{g} Fx")
-            row[2].plot(t, f[:, 1] / 1e3, lw=lw, ls="--", label=f"{g} Fy")
-        row[2].set(title=f"{body}: loads [kN] (global axes)", xlabel="time [s]")
-        for ax in row:
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=7)
-    fig.suptitle(f"{manifest['scene']} ({result.algorithm}, step {result.step:g} s)")
-    fig.tight_layout()
-    fig.savefig(Path(path), dpi=110)
+    bodies = sorted(manifest["dynamics"])
+    sides = joint_sides(manifest)
+    loads = {b: body_loads(result, manifest, b) for b in bodies}
+    colours = effect_colours({e for ld in loads.values() for e in ld} | set(sides))
+    rows = 2 * len(bodies) + len(sides)
+    fig, axes = plt.subplots(rows, 3, figsize=(15, 2.9 * rows + 0.9), squeeze=False)
+    r = 0
+    for body in bodies:
+        pos, att = result.motion(body, "position", 3), result.motion(body, "attitude", 3)
+        dpos, datt = relative_motion(pos, att)
+        x0 = ", ".join(f"{v:g}" for v in pos[0])
+        a0 = ", ".join(f"{v:.3g}" for v in np.degrees(att[0]))
+        ld = loads[body]
+        kn = lambda i: [(e, i % 3, v[:, i] / 1e3) for e, v in ld.items()]
+        _panel(axes[r, 0], t, [(None, i, dpos[:, i]) for i in range(3)],
+               f"{body}: translation x, y, z from ({x0}) m [m]", colours, robust=False)
+        _panel(axes[r, 1], t, kn(0) + kn(1), f"{body}: horizontal force Fx, Fy [kN]", colours)
+        _panel(axes[r, 2], t, kn(2), f"{body}: vertical force Fz [kN]", colours)
+        _panel(axes[r + 1, 0], t, [(None, i, np.degrees(datt[:, i])) for i in range(3)],
+               f"{body}: rotation roll, pitch, yaw from ({a0}) deg [deg]", colours, robust=False)
+        _panel(axes[r + 1, 1], t, kn(5), f"{body}: yaw moment Mz [kN·m]", colours)
+        _panel(axes[r + 1, 2], t, kn(3) + kn(4), f"{body}: roll, pitch moments Mx, My [kN·m]", colours)
+        r += 2
+    for joint, (a, b) in sorted(sides.items()):
+        gap = result.vector(joint, "gap", 3) * 1e3
+        rot = np.degrees(result.vector(joint, "rotation", 3))
+        force = result.vector(joint, "A.force", 6) / 1e3
+        between = f"{a}–{b or 'earth'}"
+        _panel(axes[r, 0], t, [(joint, i, gap[:, i]) for i in range(3)],
+               f"joint {joint} ({between}): gap x, y, z [mm]", colours)
+        _panel(axes[r, 1], t, [(joint, i, rot[:, i]) for i in range(3)],
+               f"joint {joint}: relative rotation about A's x, y, z [deg]", colours)
+        _panel(axes[r, 2], t, [(joint, i, force[:, i]) for i in range(3)],
+               f"joint {joint}: force on {a} Fx, Fy, Fz [kN]", colours)
+        r += 1
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    handles = ([Line2D([], [], color=c, lw=2.0 if e == TOTAL else 1.2, label=e) for e, c in colours.items()]
+               + [Line2D([], [], color="0.3", ls=ls, label=lab)
+                  for ls, lab in zip(LINESTYLES, ("x / Fx / Mx / roll", "y / Fy / My / pitch", "z / Fz / Mz / yaw"))])
+    fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 8), fontsize=8, frameon=False,
+               bbox_to_anchor=(0.5, 1 - 0.4 / fig.get_figheight()))
+    fig.suptitle(f"{manifest['scene']} ({result.algorithm}, step {result.step:g} s): loads on each body, "
+                 f"global axes, moments about its reference point", fontsize=11, y=1 - 0.1 / fig.get_figheight())
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.6 / fig.get_figheight()))
+    fig.savefig(Path(path), dpi=100)
     plt.close(fig)

@@ -1,0 +1,105 @@
+"""The package's top-level calls: scene file → FMUs → run → Result.
+
+``hydrofmu.load_scene``, ``hydrofmu.build`` and ``hydrofmu.run`` are these functions; the
+command line (``hydrofmu build``/``run``) is a thin layer over them.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable, Mapping, Sequence
+
+from .scene import Scene, load_scene
+
+if TYPE_CHECKING:
+    from .cosim.result import Result
+
+DEFAULT_OUT = Path("build") / "fmus"
+
+__all__ = ["load_scene", "build", "run", "outputs"]
+
+
+def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
+          log: Callable[[str], object] = print) -> Path:
+    """Build the FMUs of a scene.
+
+    Parameters
+    ----------
+    scene : str, Path or Scene
+        A scene file (``.toml``, validated first) or a Scene from `load_scene`.
+    out : str or Path, default ``build/fmus``
+        Parent folder: the scene is built into ``out/<scene name>/`` (FMUs,
+        ``manifest.json``, ``OspSystemStructure.xml``), replacing an earlier build only
+        when the whole build succeeded.
+    log : callable, default print
+        Receives one line per built FMU and the build's reports (fits, stability
+        indicators); ``lambda s: None`` keeps it quiet.
+
+    Returns
+    -------
+    Path
+        The built scene folder.
+
+    Raises
+    ------
+    hydrofmu.InputError
+        The scene is invalid (the message names file, key path and field).
+    """
+    from .fmi.build import build_scene
+
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    return Path(build_scene(scene, Path(out), log=log))
+
+
+def run(source: str | Path | Scene, *, stop: float | None = None, step: float | None = None,
+        algorithm: str | None = None, engine: str = "fmpy", out: str | Path = DEFAULT_OUT,
+        record: Sequence[str] | None = None, parameters: Mapping[str, float] | None = None,
+        log: Callable[[str], object] = print) -> Result:
+    """Run a scene: one call from a scene file (built first) or a built folder to a Result.
+
+    Parameters
+    ----------
+    source : str, Path or Scene
+        A scene file (``.toml``) or Scene, built into ``out/<scene name>/`` first, or a
+        built scene folder (holding ``manifest.json``).
+    stop, step : float, optional
+        End time and communication step [s]; default: the scene's ``[run]`` settings
+        (its preset's, unless the scene sets them).
+    algorithm : {'gauss-seidel', 'jacobi'}, optional
+        Master algorithm of the fmpy engine (libcosim is always Jacobi); default: the
+        scene's.
+    engine : {'fmpy', 'libcosim'}, default 'fmpy'
+        hydrofmu's fmpy master, or the Open Simulation Platform's libcosim (needs
+        libcosimpy, in the ``test`` extra).
+    out : str or Path, default ``build/fmus``
+        Where a scene file is built (see `build`).
+    record : sequence of str, optional
+        ``'instance.variable'`` outputs to record (default: every output of every FMU).
+    parameters : mapping, optional
+        ``{'instance.variable': value}`` set in initialization mode (fmpy engine).
+    log : callable, default print
+        Receives the build's lines when a scene file is built.
+
+    Returns
+    -------
+    Result
+        Time, recorded columns with their units, the run's settings and the manifest
+        (``Result.to_csv``, ``Result.plot``).
+    """
+    folder = source
+    if isinstance(source, Scene) or Path(source).suffix == ".toml":
+        folder = build(source, out, log=log)
+    if engine == "libcosim":
+        from .cosim.libcosim import run as run_libcosim
+        return run_libcosim(folder, stop=stop, step=step, record=record)
+    if engine != "fmpy":
+        raise ValueError(f"engine must be 'fmpy' or 'libcosim', found {engine!r}")
+    from .cosim.master import run as run_fmpy
+    return run_fmpy(folder, stop=stop, step=step, algorithm=algorithm, record=record, parameters=parameters)
+
+
+def outputs(folder: str | Path) -> tuple[Path, Path]:
+    """Where ``hydrofmu run``/``demo`` write the CSV and PNG of a built scene folder:
+    next to it, ``<folder>.csv`` and ``<folder>.png``."""
+    folder = Path(folder)
+    return folder.with_name(folder.name + ".csv"), folder.with_name(folder.name + ".png")
