@@ -1,5 +1,6 @@
-"""Hydrodynamic coupling loads: element rule of the manual, DESIGN.md formula, transpose rule,
-self-coupling, and the explicit-coupling stability indicator."""
+"""Hydrodynamic coupling loads: element rule of the manual, the README's formula (SIMO
+hydrodynamic coupling), transpose rule, self-coupling, and the explicit-coupling stability
+indicator."""
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +96,7 @@ def test_design_formula_full_matrices(method):
     tol = 1e-10 if method == "convolution" else 1e-3
     np.testing.assert_allclose(f_a + c.acceleration_load("A", a_b), exp_a, atol=tol * scale)
     np.testing.assert_allclose(f_b + c.acceleration_load("B", a_a), exp_b, atol=tol * scale)
-    # DESIGN.md matrix form
+    # the README's matrix form
     np.testing.assert_allclose(c.acceleration_load("B", a_a), -data.added_mass.T @ a_a, rtol=1e-12)
 
 

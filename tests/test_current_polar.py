@@ -129,7 +129,7 @@ def rot(att):
 
 
 def expected(k, att, vel, u, rho):
-    """DESIGN.md formula written out with np.interp(period=360)."""
+    """The README's formula (DeepLines `*CURRENTPOL`) written out with np.interp(period=360)."""
     r = rot(att)
     p = r @ np.array([k.xc, k.yc, k.zc])
     vb = r.T @ (u - (vel[:3] + np.cross(vel[3:], p)))

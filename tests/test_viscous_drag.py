@@ -1,4 +1,4 @@
-"""ViscousDrag kernel against hand computations of F_body = −V·(w∘|w|) (DESIGN.md)."""
+"""ViscousDrag kernel against hand computations of F_body = −V·(w∘|w|) (README, Conventions: AQWA `*Viscous Drag`)."""
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +20,7 @@ def rot(att):
 
 
 def expected(matrix, att, vel, current=None):
-    """Formula of DESIGN.md written out: w in body axes, optional relative linear part."""
+    """Formula of the README (AQWA `*Viscous Drag`) written out: w in body axes, optional relative linear part."""
     r = rot(att)
     lin = np.asarray(vel[:3], float) - (0.0 if current is None else np.asarray(current))
     w = np.concatenate([r.T @ lin, r.T @ np.asarray(vel[3:], float)])

@@ -23,7 +23,7 @@ __version__ = "0.1.0"
 
 # public name -> module (relative to the package) that defines it
 _WHERE = {
-    "load_scene": "scene", "Scene": "scene", "InputError": "errors",
+    "load_scene": "api", "Scene": "scene", "InputError": "errors",
     "build": "api", "run": "api",
     "Result": "cosim.result", "read_csv": "cosim.result",
     "ViscousDrag": "physics.viscous_drag", "CurrentPolar": "physics.current_polar",
@@ -48,7 +48,7 @@ def __dir__():
 
 
 if TYPE_CHECKING:   # for type checkers and IDEs; never executed
-    from .api import build, run
+    from .api import build, load_scene, run
     from .cosim.result import Result, read_csv
     from .errors import InputError
     from .physics.coupling import Coupling
@@ -60,4 +60,4 @@ if TYPE_CHECKING:   # for type checkers and IDEs; never executed
     from .physics.rigid_body import CoupledBodies, RigidBody
     from .physics.state import Env, Motion
     from .physics.viscous_drag import ViscousDrag
-    from .scene import Scene, load_scene
+    from .scene import Scene

@@ -8,7 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 
-from .scene import Scene, load_scene
+from . import scene as _scene
+from .scene import Scene
 
 if TYPE_CHECKING:
     from .cosim.result import Result
@@ -16,6 +17,29 @@ if TYPE_CHECKING:
 DEFAULT_OUT = Path("build") / "fmus"
 
 __all__ = ["load_scene", "build", "run", "outputs"]
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scene (TOML; format in the README).  Vendor decks it names are read
+        relative to it.
+
+    Returns
+    -------
+    Scene
+        Bodies (pose, mass properties, effects with their deck data read), joints,
+        couplings, environment and run settings (preset resolved).
+
+    Raises
+    ------
+    hydrofmu.InputError
+        Every problem of the file at once, each named by file, key path and field.
+    """
+    return _scene.load_scene(path)
 
 
 def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,

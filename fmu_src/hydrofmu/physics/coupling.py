@@ -1,6 +1,6 @@
 """Hydrodynamic coupling between two bodies A and B (SIMO `HYDRodynamic COUPling DATA`).
 
-Loads (DESIGN.md), 6-vectors [force N; moment N·m] on each body, in the same axes and about the
+Loads (README, Conventions: SIMO hydrodynamic coupling), 6-vectors [force N; moment N·m] on each body, in the same axes and about the
 same reference point as the 6-vector velocities v [m/s, rad/s] and accelerations a [m/s², rad/s²]:
 
     F_B = −A∞ᵀ·a_A − ∫ hᵀ(t − τ)·v_A(τ) dτ

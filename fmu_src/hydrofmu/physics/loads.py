@@ -1,7 +1,8 @@
 """All the load kernels of one body, summed: the physics behind a body's FMU.
 
 Kernels are built from plain data (the scene's effect tables, decks already read), so
-the FMU only carries JSON.  Acceleration loads follow DESIGN.md's two modes:
+the FMU only carries JSON.  Acceleration loads follow the two modes of the README
+(Conventions: Acceleration loads):
 
 - ``export``: the effect's acceleration loads are not applied; their 6×6 mass
   contribution (about the reference point, global axes, evaluated at the initial pose)

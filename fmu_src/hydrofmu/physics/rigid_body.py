@@ -2,8 +2,8 @@
 co-simulation tests.  Pure numpy; the FMU wrapper feeds it the summed loads of the load
 FMUs and publishes its motion.
 
-Conventions (DESIGN.md)
------------------------
+Conventions (README, Conventions: Frames and motion, Signs)
+-----------------------------------------------------------
 - Global frame earth-fixed, right-handed, z up.  SI units.
 - Pose η = [x, y, z, φ, θ, ψ]: position of the reference point O [m], global axes, and
   attitude (roll, pitch, yaw) [rad]; body-to-global rotation R = Rz(ψ)·Ry(θ)·Rx(φ).

@@ -1,0 +1,149 @@
+"""Outputs people read: the plots' data choices on synthetic series (hand-computed), CSV
+headers with units (parsed), `hydrofmu run` writing CSV + PNG next to the build, complete
+--help texts, and the light public API."""
+import argparse
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import MODELS, ROOT
+from hydrofmu.cosim.report import body_loads, effect_colours, joint_sides, relative_motion, robust_limits
+from hydrofmu.cosim.result import Result, read_csv, split_header
+
+
+def test_relative_motion_starts_at_zero_and_unwraps_yaw():
+    # barge_b of joined_barges: starts at x = 100 m, y = 35 m and drifts by centimetres
+    pos = np.array([[100.0, 35.0, 0.0], [100.02, 35.01, -0.001], [100.05, 35.0, 0.0]])
+    # yaw through +π: 3.1 -> -3.1 rad is a turn of +(2π - 6.2) = +0.0832 rad, not -6.2
+    att = np.array([[0.01, 0.0, 3.1], [0.0, 0.0, 3.14], [0.0, 0.02, -3.1]])
+    dpos, datt = relative_motion(pos, att)
+    np.testing.assert_allclose(dpos, [[0, 0, 0], [0.02, 0.01, -0.001], [0.05, 0.0, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(datt, [[0, 0, 0], [-0.01, 0.0, 0.04], [-0.01, 0.02, 2 * np.pi - 6.2]], atol=1e-12)
+
+
+def test_robust_limits_clip_a_start_spike_and_say_so():
+    # a −700 kN start spike before a steady load of 50..60 kN (ramp): t = 0..100 s
+    t = np.arange(101.0)
+    y = 50 + t / 10
+    y[0] = -700.0
+    lo, hi, clipped = robust_limits(t, [y])
+    # settled part t >= 10 s: 51.0..60.0 in 91 samples; 1st/99th percentiles (linear
+    # interpolation at position 0.01·90 = 0.9): 51.09 and 59.91; span 8.82; pad 10 %
+    p_lo, p_hi = 51.0 + 0.9 * 0.1, 60.0 - 0.9 * 0.1
+    pad = 0.1 * (p_hi - p_lo)
+    assert lo == pytest.approx(p_lo - pad) and hi == pytest.approx(p_hi + pad)
+    assert clipped == (-700.0, 60.0)
+
+
+def test_robust_limits_keep_every_point_without_a_transient():
+    # a decaying oscillation (amplitude 1 -> 0.5) is the signal, not a transient: whole span
+    t = np.linspace(0.0, 100.0, 1001)
+    y = np.exp(-t * np.log(2) / 100) * np.cos(t)
+    lo, hi, clipped = robust_limits(t, [y, 0.5 * y])
+    span = y.max() - y.min()
+    assert clipped is None
+    assert lo == pytest.approx(y.min() - 0.1 * span) and hi == pytest.approx(y.max() + 0.1 * span)
+    # a flat line gets ±10 % of its value, a zero line ±1
+    assert robust_limits(t, [np.full_like(t, 50.0)]) == (pytest.approx(45.0), pytest.approx(55.0), None)
+    assert robust_limits(t, [np.zeros_like(t)]) == (-1.0, 1.0, None)
+
+
+def test_one_colour_per_effect_in_every_row():
+    row_a = ["viscous_drag", "current_polar", "clump", "total"]
+    row_b = ["current_polar", "viscous_drag", "hitch", "total"]
+    colours = effect_colours(row_a + row_b)
+    assert colours["total"] == "black"
+    named = [colours[e] for e in ("clump", "current_polar", "hitch", "viscous_drag")]
+    assert len(set(named)) == 4 and "black" not in named
+
+
+def test_joint_forces_join_the_loads_of_both_sides():
+    manifest = {
+        "dynamics": {"a": ["a_dyn", ""], "b": ["ab_dyn", "b."]},
+        "instances": {"a": {"kind": "load", "body": "a"}, "hitch": {"kind": "joint", "body": "a"},
+                      "anchor": {"kind": "joint", "body": "b"}},
+        "connections": [["a_dyn", "position[1]", "hitch", "A.position[1]"],
+                        ["ab_dyn", "b.position[1]", "hitch", "B.position[1]"],
+                        ["ab_dyn", "b.position[1]", "anchor", "A.position[1]"]],
+    }
+    assert joint_sides(manifest) == {"hitch": ("a", "b"), "anchor": ("b", None)}
+    t = np.arange(3.0)
+    drag = np.arange(18.0).reshape(3, 6)
+    cols = ([f"a.force[{i}]" for i in range(1, 7)] + [f"a.drag.force[{i}]" for i in range(1, 7)]
+            + [f"hitch.{s}.force[{i}]" for s in "AB" for i in range(1, 7)])
+    values = np.hstack([drag, drag, np.ones((3, 6)), -np.ones((3, 6))])
+    result = Result(t, cols, values, "jacobi", 1.0)
+    loads_a, loads_b = body_loads(result, manifest, "a"), body_loads(result, manifest, "b")
+    assert sorted(loads_a) == ["drag", "hitch", "total"] and sorted(loads_b) == ["hitch", "total"]
+    np.testing.assert_array_equal(loads_a["total"], drag + 1)
+    np.testing.assert_array_equal(loads_b["total"], -np.ones((3, 6)))
+
+
+def test_csv_headers_carry_units_and_read_back(demo_build, tmp_path):
+    from hydrofmu.cosim.master import run
+    result = run(demo_build, stop=0.5)
+    path = result.to_csv(tmp_path / "run.csv")
+    header = path.read_text().splitlines()[0].split(",")
+    units = dict(split_header(cell) for cell in header)
+    # the FMI units of the README: SI, forces N, moments N.m, angles rad
+    assert units["time"] == "s"
+    for i in range(1, 4):
+        assert units[f"barge.force[{i}]"] == "N" and units[f"barge.force[{i + 3}]"] == "N.m"
+        assert units[f"barge_dynamics.position[{i}]"] == "m"
+        assert units[f"barge_dynamics.attitude[{i}]"] == "rad"
+        assert units[f"barge_dynamics.velocity[{i}]"] == "m/s"
+        assert units[f"barge_dynamics.velocity[{i + 3}]"] == "rad/s"
+        assert units[f"barge.viscous_drag.force[{i + 3}]"] == "N.m"
+    assert all(u for u in units.values()), [c for c, u in units.items() if not u]
+    back = read_csv(path, demo_build)
+    assert back.columns == result.columns and back.step == pytest.approx(0.1)
+    np.testing.assert_array_equal(back.values, result.values)   # repr: full precision
+    np.testing.assert_array_equal(back.motion("barge", "position", 3), result.motion("barge", "position", 3))
+    assert split_header("x.force[1]") == ("x.force[1]", "") and split_header("a [-]") == ("a", "")
+
+
+def _hydrofmu(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "hydrofmu.cli", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_run_writes_csv_and_png_next_to_the_build_and_says_where(tmp_path):
+    out = tmp_path / "fmus"
+    done = _hydrofmu("run", str(MODELS / "moored_barge.toml"), "-o", str(out), "--stop", "1", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    csv, png = out / "moored_barge.csv", out / "moored_barge.png"
+    assert f"in {out / 'moored_barge'}" in done.stdout             # where it built
+    assert f"wrote {csv} and {png}" in done.stdout                  # where it wrote
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert len(read_csv(csv).time) == 11
+
+
+def test_every_option_has_a_help_text():
+    from hydrofmu.cli import make_parser
+    parser = make_parser()
+    subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    assert sorted(subs.choices) == ["bench", "build", "demo", "run", "validate"]
+    for name, sub in subs.choices.items():
+        assert sub.description, name
+        for action in sub._actions:
+            assert action.help, f"{name} {action.dest}"
+        text = sub.format_help()
+        for action in sub._actions:   # a default worth saying is said once
+            if action.default not in (None, False, argparse.SUPPRESS):
+                assert text.count("default:") >= 1, name
+        assert "(default: None)" not in text and text.count("(default: the scene's) (default") == 0
+
+
+def test_public_api_is_light_and_complete():
+    code = ("import sys, hydrofmu; heavy = [m for m in ('numpy', 'fmpy', 'matplotlib', 'scipy') if m in sys.modules]; "
+            "print(heavy); [getattr(hydrofmu, n) for n in hydrofmu.__all__]; print('ok')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert done.stdout.split("\n")[:2] == ["[]", "ok"], done.stderr
+    import hydrofmu
+    from hydrofmu.physics.viscous_drag import ViscousDrag
+    assert hydrofmu.ViscousDrag is ViscousDrag and hydrofmu.Result is Result
+    for name in ("load_scene", "build", "run", "read_csv"):
+        doc = getattr(hydrofmu, name).__doc__
+        assert "Parameters" in doc and "Returns" in doc, name   # numpydoc sections
