@@ -147,3 +147,26 @@ def test_public_api_is_light_and_complete():
     for name in ("load_scene", "build", "run", "read_csv"):
         doc = getattr(hydrofmu, name).__doc__
         assert "Parameters" in doc and "Returns" in doc, name   # numpydoc sections
+
+
+def test_labels_of_crowded_points_do_not_overlap():
+    # the memory trade-off's crowd: state-space points within 1 µs of each other
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.transforms import Bbox
+    from hydrofmu.cosim.report import annotate_apart
+    xs = [4.9, 5.0, 5.0, 5.1, 5.3, 5.7, 12, 16, 23, 40, 100]
+    ys = [1.0, 0.6, 0.05, 0.018, 0.0037, 0.0021, 0.9, 0.3, 0.0079, 1e-4, 1e-5]
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    ax.loglog(xs, ys, "o")
+    ax.margins(x=0.25, y=0.15)
+    fig.tight_layout()
+    labels = annotate_apart(ax, xs, ys, [f"state_space tol {i}" for i in range(len(xs))])
+    renderer = fig.canvas.get_renderer()
+    boxes = [a.get_window_extent(renderer) for a in labels]
+    points = ax.transData.transform(np.column_stack([xs, ys]))
+    for i, box in enumerate(boxes):
+        assert not any(box.overlaps(b) for b in boxes[:i]), labels[i].get_text()
+        assert not any(Bbox([[px - 1, py - 1], [px + 1, py + 1]]).overlaps(box) for px, py in points)
+    plt.close(fig)

@@ -207,3 +207,41 @@ def plot(result, manifest, path):
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.6 / fig.get_figheight()))
     fig.savefig(Path(path), dpi=100)
     plt.close(fig)
+
+
+# label offsets [points] tried in turn: right above, right below, left above, left below, farther out
+OFFSETS = [(5, 3), (5, -10), (-5, 3), (-5, -10), (5, 12), (5, -19), (-5, 12), (-5, -19), (5, 21), (5, -28),
+           (-5, 21), (-5, -28)]
+
+
+def annotate_apart(ax, xs, ys, labels, fontsize=7, avoid=()):
+    """Label points so that no label covers another label, a point or an artist of
+    ``avoid`` (texts, legends): each label takes the
+    first offset of ``OFFSETS`` whose box is free and inside the axes (else the first one,
+    with a leader line).  Call after the axes' scales, limits and layout are final.
+    Returns the annotations."""
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    points = ax.transData.transform(np.column_stack([xs, ys]))
+    r = 4 * fig.dpi / 72   # marker half-size [px]
+    from matplotlib.transforms import Bbox
+    taken = [Bbox([[px - r, py - r], [px + r, py + r]]) for px, py in points]
+    taken += [a.get_window_extent(renderer) for a in avoid]
+    placed = []
+    for x, y, label in zip(xs, ys, labels):
+        for i, (dx, dy) in enumerate(OFFSETS + [OFFSETS[0]]):
+            last = i == len(OFFSETS)
+            ann = ax.annotate(label, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
+                              ha="left" if dx > 0 else "right",
+                              arrowprops=dict(arrowstyle="-", color="0.5", lw=0.5) if last else None)
+            box = ann.get_window_extent(renderer)
+            free = (frame.contains(box.x0, box.y0) and frame.contains(box.x1, box.y1)
+                    and not any(box.overlaps(b) for b in taken))
+            if free or last:
+                break
+            ann.remove()
+        taken.append(box)
+        placed.append(ann)
+    return placed
