@@ -123,10 +123,10 @@ def test_wamit_scene_gives_the_capytaine_couplings(tmp_path):
     nc = load_scene(write_scene(tmp_path, bodies_text() + bem_text(extra="kernel_length = 30.0"), "nc.toml"))
     for cw, cn in zip(wamit.couplings, nc.couplings):
         assert (cw.name, cw.a, cw.b) == (cn.name, cn.a, cn.b)
-        assert cw.data["timdel"] == pytest.approx(cn.data["timdel"], rel=1e-12)
-        np.testing.assert_allclose(cw.data["added_mass"], cn.data["added_mass"], rtol=1e-9, atol=1e-6)
-        kw = {(i, j): h for i, j, h in cw.data["kernels"]}
-        kn = {(i, j): h for i, j, h in cn.data["kernels"]}
+        assert cw.timdel == pytest.approx(cn.timdel, rel=1e-12)
+        np.testing.assert_allclose(cw.added_mass, cn.added_mass, rtol=1e-9, atol=1e-6)
+        kw = {(k.dof_a, k.dof_b): k.values for k in cw.kernels}
+        kn = {(k.dof_a, k.dof_b): k.values for k in cn.kernels}
         assert kw.keys() == kn.keys()
         for key in kn:
             np.testing.assert_allclose(kw[key], kn[key], rtol=0, atol=1e-9 * np.abs(kn[key]).max())
