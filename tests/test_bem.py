@@ -118,9 +118,20 @@ def test_wamit_scene_gives_the_capytaine_couplings(tmp_path):
         bem = "cyl.1"
         ulen = {ulen}
         bodies = {{ body1 = "a", body2 = "b" }}
+        rotation_centers = {{ body1 = [0.0, -4.0, 0.0], body2 = [0.0, 4.0, 0.0] }}
         kernel_length = 30.0
         """, "w.toml"))
     nc = load_scene(write_scene(tmp_path, bodies_text() + bem_text(extra="kernel_length = 30.0"), "nc.toml"))
+    assert "rotation centres (the scene's reference points, checked) body1" in "".join(wamit.couplings[0].bem.report())
+    # a declared centre (WAMIT's XBODY) off the scene's reference point is an error
+    with pytest.raises(InputError, match=r"rotation_center\[body2\]"):
+        load_scene(write_scene(tmp_path, bodies_text() + """
+            [[couplings]]
+            bem = "cyl.1"
+            ulen = 2.0
+            bodies = { body1 = "a", body2 = "b" }
+            rotation_centers = { body1 = [0.0, -4.0, 0.0], body2 = [0.0, 6.0, 0.0] }
+            """, "off.toml"))
     for cw, cn in zip(wamit.couplings, nc.couplings):
         assert (cw.name, cw.a, cw.b) == (cn.name, cn.a, cn.b)
         assert cw.timdel == pytest.approx(cn.timdel, rel=1e-12)

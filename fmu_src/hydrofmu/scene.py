@@ -428,7 +428,7 @@ def _coupling(name, a, b, d, knobs, bem=None):
 
 
 BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance",
-            "method", "tolerance", "order", "memory_length"}
+            "rotation_centers", "method", "tolerance", "order", "memory_length"}
 CENTRE_TOL = 0.01   # m: BEM rotation centres vs scene reference points
 
 
@@ -453,7 +453,10 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
     opt = {k: problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None
            for k in ("ulen", "timdel", "kernel_length", "symmetry_tolerance")}
     knobs = _memory_knobs(problems, table, where, memory)
-    if file is None or mapping is None or knobs[0] is None or prefix is None or not identifier(prefix):
+    centres = problems.table(table, "rotation_centers", f"{where}.rotation_centers", required=False) or {}
+    centres = {b: problems.vector(centres, b, f"{where}.rotation_centers.{b}", 3) for b in centres}
+    if file is None or mapping is None or knobs[0] is None or prefix is None or not identifier(prefix) \
+            or None in centres.values():
         if prefix is not None and not identifier(prefix):
             problems.add(f"{where}.name", f"expected an identifier, found {prefix!r}")
         return []
@@ -470,6 +473,14 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
                 raise InputError(path, None, name, f"{name} = {value:g} in the BEM result but {scene_value:g} in the "
                                                    f"scene (environment.{name}): solve again with {name} = "
                                                    f"{scene_value:g}, or set environment.{name} = {value:g}")
+        for b, xyz in centres.items():     # declared (WAMIT's XBODY); a file's own value must agree
+            if b not in data.bodies:
+                raise InputError(path, None, "rotation_centers", f"{b!r} is not a body of the result "
+                                                                 f"(it has: {', '.join(data.bodies)})")
+            if b in data.rotation_centers and np.max(np.abs(np.subtract(data.rotation_centers[b], xyz))) > CENTRE_TOL:
+                raise InputError(path, None, f"rotation_center[{b}]", f"{data.rotation_centers[b]} m in the file "
+                                                                      f"but {xyz} m declared in the scene")
+            data.rotation_centers[b] = list(xyz)
         _check_centres(data, mapping, bodies)
         result = bem.couplings(data, mapping, dofs, opt["timdel"], opt["kernel_length"],
                                opt["symmetry_tolerance"] or SYMMETRY_TOL, prefix)
