@@ -70,10 +70,10 @@ BAD = {
     "rows after reference": ("*Viscous Drag\n" + _body(extra="VISCOUS DRAG=X\n"), 4, "FLOATING BODY"),
     "duplicate named matrix": ("*Viscous Drag Coefficients\nNAME=X\n" + ROWS6 + "\nname = x\n" + ROWS6
                                + "\n*Viscous Drag\n" + _body(), 9, "NAME"),
-    "unknown keyword": ("*Viscous Drag\n" + _body() + "*Hydrostatics\n", 11, "*Viscous Drag"),
+    "misspelt keyword": ("*Viscous Drag\n" + _body() + "*Viscous Drg\n", 11, "*Viscous Drag"),
     "unknown setting": ("*Viscous Drag\n" + _body(extra="COLOUR=red\n"), 3, "COLOUR"),
     "empty section": ("*Viscous Drag\n*Viscous Drag Coefficients\nNAME=X\n" + ROWS6 + "\n", 1, "FLOATING BODY"),
-    "line before keyword": (_body(), 1, "*Viscous Drag"),
+    "other viscous keyword": ("*Viscous Damping\n" + _body(), 1, "*Viscous Drag"),
 }
 
 

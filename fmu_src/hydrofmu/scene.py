@@ -216,13 +216,21 @@ def _deck_path(problems, table, where):
     return path
 
 
-def _from_deck(problems, table, where, reader, name_key):
-    """Read a deck and pick the named entry; deck errors are recorded, not raised."""
+def _units(problems, table, where):
+    """The ``units`` of a SIMO/RIFLEX deck reference (decks/units.py), default SI."""
+    from .decks.units import SYSTEMS
+    return problems.choice(table, "units", f"{where}.units", tuple(SYSTEMS), "SI")
+
+
+def _from_deck(problems, table, where, reader, name_key, units=False):
+    """Read a deck and pick the named entry; deck errors are recorded, not raised.
+    ``units``: the reader takes the file's unit system (scene key ``units``)."""
     path = _deck_path(problems, table, where)
     name = problems.string(table, name_key, f"{where}.{name_key}")
-    if path is None or name is None:
+    system = _units(problems, table, where) if units else None
+    if path is None or name is None or (units and system is None):
         return None, None
-    entries = problems.deck(path, f"{where}.deck", reader)
+    entries = problems.deck(path, f"{where}.deck", reader, *((system,) if units else ()))
     if entries is None:
         return None, None
     if name not in entries:
@@ -291,7 +299,7 @@ def _lumped_data(problems, table, where, kind):
     inline; ``kind`` is 'BODY' or 'CONB'.  Returns (data dict, conb codes or None)."""
     from .decks.riflex import BodyData, ConbData, read_components
     if "deck" in table:
-        comp, path = _from_deck(problems, table, where, read_components, "component")
+        comp, path = _from_deck(problems, table, where, read_components, "component", units=True)
         if comp is None:
             return None, None
         want = BodyData if kind == "BODY" else ConbData
@@ -321,7 +329,7 @@ def _lumped_data(problems, table, where, kind):
 
 
 def _riflex_body(problems, table, where):
-    keys = {"type", "name", "offset"} | ({"deck", "component"} if "deck" in table else LUMPED_KEYS)
+    keys = {"type", "name", "offset"} | ({"deck", "component", "units"} if "deck" in table else LUMPED_KEYS)
     problems.known_keys(table, where, keys)
     offset = problems.vector(table, "offset", f"{where}.offset", 3)
     data, _ = _lumped_data(problems, table, where, "BODY")
@@ -353,7 +361,7 @@ PRESETS = {
 }
 
 
-COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length"}
+COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length", "units"}
 
 
 def _memory_knobs(problems, table, where, memory):
@@ -397,9 +405,10 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         path = _deck_path(problems, table, where)
         name = problems.string(table, "coupling", f"{where}.coupling")
         knobs = _memory_knobs(problems, table, where, memory)
-        if path is None or name is None or knobs[0] is None:
+        units = _units(problems, table, where)
+        if path is None or name is None or knobs[0] is None or units is None:
             continue
-        decks = problems.deck(path, f"{where}.deck", read_couplings, frozenset(known))
+        decks = problems.deck(path, f"{where}.deck", read_couplings, frozenset(known), units)
         if decks is None:
             continue
         if name not in decks:
@@ -534,7 +543,7 @@ class Joint:
 
 
 def _joint(problems, name, table, where, bodies):
-    keys = JOINT_KEYS | ({"deck", "component"} if "deck" in table else LUMPED_KEYS | {"codes"})
+    keys = JOINT_KEYS | ({"deck", "component", "units"} if "deck" in table else LUMPED_KEYS | {"codes"})
     problems.known_keys(table, where, keys)
     if not identifier(name) or name in bodies or name.endswith("_dynamics"):
         problems.add(where, "joint name must be an identifier that is not a body's name")

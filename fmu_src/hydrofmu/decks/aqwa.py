@@ -32,7 +32,10 @@ of giving the six rows::
     VISCOUS DRAG=HullDrag
 
 The sections may come in any order and repeat. A section runs until the next line
-starting with ``*``. Other ``*`` keywords are an error (nothing is skipped silently).
+starting with ``*``. A whole AQWA input holds other ``*`` sections (geometry, mass,
+environment, …): they are skipped, as are lines before the first section; a ``*`` keyword
+that starts with ``Viscous`` but is neither of ours is an error (a misspelt section is
+not skipped silently).
 Lines starting with ``#`` or ``!`` are comments. Names keep their spelling and inner
 blanks; two bodies (or two matrices) whose names differ only by case are duplicates.
 
@@ -88,13 +91,13 @@ def read_viscous_drag(path):
     while pos < len(lines):
         line = lines[pos]
         section = _section(line)
-        if section is None:
-            raise line.error("*Viscous Drag", f"expected a *Viscous Drag or *Viscous Drag Coefficients "
-                                              f"keyword line, found {line.text!r}")
         end = pos + 1
         while end < len(lines) and not lines[end].text.startswith("*"):
             end += 1
         block = lines[pos + 1:end]
+        if section is None:
+            pos = end          # another section of the AQWA input (or lines before the first): skipped
+            continue
         if section == _DRAG:
             seen_drag = True
             if not block:
@@ -123,6 +126,9 @@ def _section(line):
     if not line.text.startswith("*"):
         return None
     key = keyword_key(line.text[1:])
+    if key not in (_DRAG, _TABLE) and key[:1] == _DRAG[:1]:
+        raise line.error("*Viscous Drag", f"expected a *Viscous Drag or *Viscous Drag Coefficients "
+                                          f"keyword line, found {line.text!r}")
     return key if key in (_DRAG, _TABLE) else None
 
 

@@ -1,5 +1,19 @@
 """Line-level tools shared by the deck readers: numbered lines, keyword matching,
-typed fields with errors that name the file, the line and the field."""
+typed fields with errors that name the file, the line and the field.
+
+FREAD, the free-format reader of SIMO and RIFLEX input (``fread_lines``, ``fields``,
+``is_keyword``), as the readers apply it:
+
+- a data group starts with an identifier of up to three words; only the first four letters
+  of each word count, case does not (``HYDRodynamic COUPling DATA`` = ``hydr coup data``);
+- values are separated by blanks (tabs) and/or commas; a number may carry a Fortran ``D``
+  exponent (``2.5D+03``);
+- ``/`` in place of a value gives that field its default (``fields(..., defaults=)``);
+- ``&`` at the end of a line continues it on the next line;
+- ``'`` starts a comment: a line whose first non-blank character is ``'`` is skipped, and
+  text after a ``'`` on a data line is ignored;
+- ``END`` ends the input: whatever follows it is not read.
+"""
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,18 +49,24 @@ class Line:
         return self
 
 
-def read_lines(path, comment="'", continuation=None):
+DEFAULT = "/"      # FREAD: a value left to its default
+COMMENT = "'"      # FREAD: comment mark
+END = "END"        # FREAD: end of input
+
+
+def read_lines(path, comment="'", continuation=None, inline=False):
     """Non-blank, non-comment lines of a text file as ``Line`` objects.
 
     ``comment``: prefix (after leading blanks) of comment lines, or a tuple of them.
     ``continuation``: a trailing mark (e.g. ``&``) that joins a line with the next one.
+    ``inline``: a comment mark after data also ends the line's data.
     """
     path = Path(path)
     raw = read_text(path, "deck").splitlines()
     comments = (comment,) if isinstance(comment, str) else tuple(comment or ())
     out, pending = [], []   # pending: (number, text) pieces of a continued line, joined once: linear
     for number, text in enumerate(raw, start=1):
-        stripped = text.strip()
+        stripped = data_part(text, comments) if inline else text.strip()
         if not stripped or (comments and stripped.startswith(comments)):
             continue
         if continuation and stripped.endswith(continuation):
@@ -70,6 +90,26 @@ def _joined(path, pieces):
     return Line(path, pieces[0][0], " ".join(text for _, text in pieces), tuple(starts))
 
 
+def data_part(text, comments=(COMMENT,)):
+    """``text`` without a trailing comment (from the first comment mark on), stripped;
+    a comment line keeps its mark so that it is still seen as one."""
+    stripped = text.strip()
+    if stripped.startswith(comments):
+        return stripped
+    cut = min((i for i in (stripped.find(c) for c in comments) if i >= 0), default=-1)
+    return stripped if cut < 0 else stripped[:cut].rstrip()
+
+
+def fread_lines(path):
+    """The data lines of a SIMO/RIFLEX input file by the FREAD rules (module docstring)."""
+    return read_lines(path, comment=COMMENT, continuation="&", inline=True)
+
+
+def is_end(line):
+    """True for the FREAD ``END`` line that ends the input."""
+    return keyword_key(line.text) == (END,)
+
+
 def keyword_key(text):
     """Normalised keyword: the first four letters of each word, upper case.
     'NEW COMPonent BODY' and 'new comp body' both give ('NEW', 'COMP', 'BODY')."""
@@ -82,15 +122,18 @@ def is_keyword(line, keyword):
     return keyword_key(line.text) == keyword_key(keyword)
 
 
-def fields(line, names, kind=float, defaults=None):
+def fields(line, names, kind=float, defaults=None, slash=None):
     """Parse the words of ``line`` as the named fields.
 
     ``kind``: a type for all fields or a list of types, one per name.
-    ``defaults``: values for trailing fields that may be left out.
+    ``defaults``: values for fields that may be left out at the end of the line or given
+    as ``/`` (FREAD's default); ``slash``: values only ``/`` may give (a field the manual
+    prints no default for, left out on purpose); ``/`` for any other field is an error.
     Returns a dict name → value; one InputError names the first bad or missing field.
     """
     kinds = kind if isinstance(kind, (list, tuple)) else [kind] * len(names)
     defaults = defaults or {}
+    slash = {**defaults, **(slash or {})}
     words = line.words
     empty = _empty_field(line.text)
     if empty is not None and empty < len(names):
@@ -104,6 +147,11 @@ def fields(line, names, kind=float, defaults=None):
                 values[name] = defaults[name]
                 continue
             raise line.error(name, f"missing value; expected {' '.join(names)}")
+        if words[i] == DEFAULT:
+            if name not in slash:
+                raise line.error(name, f"'{DEFAULT}' asks for the default value, but {name} has none: give a value")
+            values[name] = slash[name]
+            continue
         values[name] = convert(line, name, words[i], typ)
     return values
 

@@ -9,21 +9,32 @@ case; lines starting with ' are comments; commas separate like blanks)::
     ICOO CDX CDY CDZ AMX AMY AMZ    ICOO CDX CDY CDZ AMX AMY AMZ
                                     IRX IRY IRZ        (optional line, each defaults to 0)
 
-Units: AM [kg], AE [m³], CD [N/(m/s)²], AMX.. [kg]; ICOO GLOBAL or LOCAL; IRX.. 1 fixed,
-0 free.  Every other data group, and lines before the first group, are skipped.  A line
-starts a data group when it is a NEW line or all its words begin with a letter (RIFLEX
-groups such as ``END`` or ``UNIT NAMES SPECIFICATION``): such a line ends the CONB group
-without its IRX line; any other line left after a BODY or CONB group is an error.
+Units: AM [kg], AE [m³], CD [N/(m/s)²], AMX.. [kg] after conversion from the file's
+system (decks/units.py: the scene's ``units``, checked against the file's ``UNIT NAMe
+SPECification`` line UT UL UM UF GRAV GCONS when it has one); ICOO GLOBAL or LOCAL; IRX..
+1 fixed, 0 free.
+
+FREAD rules (decks/lines.py): ``/`` gives IRX, IRY, IRZ their default 0, and AM, AE, CDX …
+AMZ the value 0 (no default printed: the term is absent); ICOO and CMPTYP-ID have none.
+``&`` continues a line, ``'`` starts a comment, ``END`` ends the input.
+
+Whole INPMOD files: every other data group, and lines before the first group, are
+skipped.  A line starts a data group when it is a NEW line or all its words begin with a
+letter (RIFLEX groups such as ``END`` or ``UNIT NAMES SPECIFICATION``): such a line ends
+the CONB group without its IRX line; any other line left after a BODY or CONB group is an
+error.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..errors import InputError
 from ..physics.lumped import LumpedBody, coordinate_code
-from .lines import Cursor, fields, is_keyword, keyword_key, read_lines
+from . import units as unit_systems
+from .lines import Cursor, fields, fread_lines, is_end, is_keyword, keyword_key
 
 HYDRO = ("ICOO", "CDX", "CDY", "CDZ", "AMX", "AMY", "AMZ")
 FREEDOM = ("IRX", "IRY", "IRZ")
 GROUPS = {"BODY": "NEW COMPonent BODY", "CONB": "NEW COMPonent CONB"}
+UNITS = "UNIT NAMe SPECification"
 
 
 @dataclass(frozen=True)
@@ -64,12 +75,18 @@ def starts_group(line):
     return keyword_key(line.text)[:1] == ("NEW",) or all(w[0].isalpha() for w in words)
 
 
-def read_components(path):
-    """All BODY and CONB components of a RIFLEX file: dict CMPTYP-ID → BodyData | ConbData."""
-    cur = Cursor(read_lines(path, comment="'"), path)
-    out = {}
+def read_components(path, units="SI"):
+    """All BODY and CONB components of a RIFLEX file: dict CMPTYP-ID → BodyData | ConbData.
+    ``units``: the file's unit system (decks/units.py); values come back in SI."""
+    cur = Cursor(fread_lines(path), path)
+    out, system = {}, None
     while not cur.done():
         line = cur.next("NEW")
+        if is_end(line):
+            break
+        if is_keyword(line, UNITS):
+            system = unit_systems.riflex_units(_next_data(cur, ("UT", "UL", "UM", "UF", "GRAV", "GCONS"), UNITS))
+            continue
         kind = next((k for k, key in GROUPS.items() if is_keyword(line, key)), None)
         if kind is None:
             continue  # another data group or its data
@@ -80,7 +97,10 @@ def read_components(path):
             raise extra.error("data group identifier",
                               f"unexpected line {extra.text!r} after {kind} {comp.name!r}; "
                               "expected a new data group (NEW ...) or the end of the file")
-    return out
+    unit_systems.check(system, units, path)
+    mass, force = unit_systems.factors(units)
+    return {k: replace(c, am=c.am * mass, cd=tuple(x * force for x in c.cd),
+                       added_mass=tuple(x * mass for x in c.added_mass)) for k, c in out.items()}
 
 
 def _next_data(cur, names, owner):
@@ -115,11 +135,11 @@ def _read_group(cur, head, kind, seen):
     owner = f"{kind} {name!r}"
 
     line = _next_data(cur, ("AM", "AE"), owner)
-    mass = fields(line, ["AM", "AE"])
+    mass = fields(line, ["AM", "AE"], slash={"AM": 0.0, "AE": 0.0})
     _non_negative(line, mass, ["AM", "AE"])
 
     line = _next_data(cur, HYDRO, owner)
-    hydro = fields(line, list(HYDRO), kind=[str] + [float] * 6)
+    hydro = fields(line, list(HYDRO), kind=[str] + [float] * 6, slash=dict.fromkeys(HYDRO[1:], 0.0))
     icoo = coordinate_code(hydro["ICOO"])
     if icoo is None:
         raise line.error("ICOO", f"expected GLOBAL or LOCAL, found {hydro['ICOO']!r}")

@@ -1,7 +1,7 @@
 """SIMO hydrodynamic coupling between bodies: reader for the `HYDRodynamic COUPling DATA` group.
 
-Deck layout (free format, `'` starts a comment line, `&` at the end of a line continues it,
-only the first four letters of each keyword word count, case does not)::
+Deck layout (FREAD rules, see decks/lines.py: keywords by their first four letters, `/` for
+a default, `&` continues a line, `'` starts a comment, blanks or commas, D exponents)::
 
     BODY DATA                        ' minimal body declaration (optional, see below)
     CHBDY                            ' body identifier
@@ -16,20 +16,31 @@ only the first four letters of each keyword word count, case does not)::
     …
     COUPled RETArdation FUNCtion     ' optional sub-group (at least one of the two is given)
     TIMDEL                           ' sample spacing of the kernels [s], > 0
-    RETArdation ELEment DATA
+    RETArdation ELEment DATA         ' once for all blocks, or again before each block
     NRETij IDOF_A IDOF_B             ' one block per element, repeated until the next group
     RETij(1) … RETij(NRETij)         ' one line, continued with & [N·s/m, N·s, N·m·s]
+
+`/` for AMij or RETij(k) gives 0 (the manual prints no default: the term is absent);
+identifiers, TIMDEL, NRETij and the dofs have no default.
+
+Whole files: a SIMO system description file holds many other data groups (``SYSTem
+DESCription SIMO``, body data, environment, …).  The reader picks out the groups above and
+skips every other line; ``END`` ends the file.  A line that starts like the coupling group
+(``HYDRodynamic COUPling …``) but is not it is an error, not skipped.  ``BODY DATA
+SPECification`` followed by the body identifier also declares a body.  The units line of
+``SYSTem DESCription SIMO`` (LENUNI TIMUNI MASUNI GRAV RHOW …) is checked against the
+scene's ``units`` (decks/units.py); values are converted to SI.
 
 Meaning (manual): an acceleration of A in dof i times AM_ij is a force on B in dof j, and an
 acceleration of B in dof j times AM_ij a force on A in dof i; the kernel of block
 (IDOF_A = i, IDOF_B = j) convolves A's velocity in i into B's dof j, and B's velocity in j
-into A's dof i (see physics/coupling.py for the signs).  Units: SI.
+into A's dof i (see physics/coupling.py for the signs).  Units: SI after conversion.
 
 Bodies: the manual requires the body data of CHBDY_A and CHBDY_B to precede the coupling.
 A body counts as defined when it is in ``bodies`` (the bodies the scene defines) or when a
 `BODY DATA` group earlier in the same file declares it: the group line followed by one line
 holding the body identifier CHBDY (SIMO's body data group; here only the identifier is read).
-Only these two groups may appear in the file.  A pair of bodies is coupled at most once.
+A pair of bodies is coupled at most once.
 """
 import re
 from dataclasses import dataclass, field
@@ -39,10 +50,13 @@ import numpy as np
 
 from ..admissible import symmetric
 from ..errors import InputError
-from .lines import Cursor, convert, fields, is_keyword, read_lines
+from . import units as unit_systems
+from .lines import DEFAULT, Cursor, convert, fields, fread_lines, is_end, is_keyword, keyword_key
 
 GROUP = "HYDRodynamic COUPling DATA"
 BODY = "BODY DATA"
+BODY_SPEC = "BODY DATA SPECification"
+SYSTEM = "SYSTem DESCription SIMO"
 ADDED_MASS = "COUPled ADDEd MASS"
 RETARDATION = "COUPled RETArdation FUNCtion"
 ELEMENTS = "RETArdation ELEment DATA"
@@ -69,19 +83,26 @@ class CouplingData:
     line: int = None
 
 
-def read_couplings(path, bodies=None):
+def read_couplings(path, bodies=None, units="SI"):
     """Read every `HYDRodynamic COUPling DATA` group of a deck: {CHCPL: CouplingData}.
 
     ``bodies``: identifiers of the bodies defined before this file (e.g. by the scene).
+    ``units``: the file's unit system (decks/units.py); values come back in SI.
     Raises InputError (file, line, field) on bad input.
     """
-    cur = Cursor(read_lines(path, continuation="&"), path)
+    cur = Cursor(fread_lines(path), path)
     declared = {}                                   # body → line of its BODY DATA group
     known = set(bodies or ())
-    out, pairs = {}, {}
+    out, pairs, system = {}, {}, None
     while not cur.done():
         line = cur.next("data group")
-        if is_keyword(line, BODY):
+        if is_end(line):
+            break
+        if is_keyword(line, SYSTEM):
+            system = _system(cur, line)
+        elif is_keyword(line, BODY_SPEC):
+            known.add(cur.next("CHBDY").words[0])
+        elif is_keyword(line, BODY):
             body_line = cur.next("CHBDY")
             name = fields(body_line, ["CHBDY"], str)["CHBDY"]
             if name in declared:
@@ -92,9 +113,33 @@ def read_couplings(path, bodies=None):
         elif is_keyword(line, GROUP):
             data = _coupling(cur, line, known, out, pairs)
             out[data.name] = data
-        else:
-            raise line.error("data group", f"expected {GROUP!r} or {BODY!r}, found {line.text!r}")
+        elif keyword_key(line.text)[:2] == keyword_key(GROUP)[:2]:
+            raise line.error("data group", f"expected {GROUP!r}, found {line.text!r}")
+        # any other line: another data group of the file, or its data: skipped
+    unit_systems.check(system, units, path)
+    mass, force = unit_systems.factors(units)
+    for data in out.values():
+        data.added_mass *= mass
+        for ij in data.kernels:
+            data.kernels[ij] *= force
     return out
+
+
+def _system(cur, head):
+    """The units line of `SYSTem DESCription SIMO`: the first of the next four lines that
+    reads as LENUNI TIMUNI MASUNI GRAV RHOW … (the three TXSYS lines come before it; a
+    blank one is not a line here)."""
+    for _ in range(4):
+        if cur.peek() is None:
+            break
+        line = cur.next("LENUNI")
+        words = line.words
+        if len(words) <= 8 and all(w == DEFAULT or w.upper() in unit_systems.UNIT_NAMES for w in words[:3]) \
+                and all(w == DEFAULT or _NUMBER.match(w) for w in words[3:]):
+            return unit_systems.simo_units(line)
+    where = cur.peek() or head
+    raise where.error("LENUNI", f"expected the units line 'LENUNI TIMUNI MASUNI GRAV RHOW ...' within four "
+                                f"lines after {SYSTEM!r} (line {head.number})")
 
 
 def _coupling(cur, start, known, out, pairs):
@@ -124,7 +169,7 @@ def _coupling(cur, start, known, out, pairs):
         head, given = cur.next(ADDED_MASS), True
         for i in range(6):
             names = [f"AM{i + 1}{j + 1}" for j in range(6)]
-            row = fields(cur.next(names[0]), names)
+            row = fields(cur.next(names[0]), names, slash=dict.fromkeys(names, 0.0))
             data.added_mass[i] = [row[n] for n in names]
         if data.body_a == data.body_b:
             _check_symmetric(head, data.added_mass)
@@ -150,7 +195,13 @@ def _coupling(cur, start, known, out, pairs):
 def _blocks(cur, data, head):
     """`NRETij IDOF_A IDOF_B` + values blocks, until a line that does not start with a number."""
     first = {}
-    while cur.peek() is not None and cur.peek().words and _NUMBER.match(cur.peek().words[0]):
+    while True:
+        nxt = cur.peek()
+        if nxt is not None and is_keyword(nxt, ELEMENTS):   # the identifier again before a block
+            cur.next(ELEMENTS)
+            continue
+        if nxt is None or not nxt.words or not _NUMBER.match(nxt.words[0]):
+            break
         hl = cur.next("NRETij")
         f = fields(hl, ["NRETij", "IDOF_A", "IDOF_B"], int)
         n = f["NRETij"]
@@ -172,7 +223,7 @@ def _blocks(cur, data, head):
                                              f"(continue a long line with '&')")
         if len(words) > n:
             raise vl.at_word(n).error(f"RETij({n + 1})", f"NRETij = {n} but {len(words)} values given")
-        data.kernels[dofs] = _numbers(vl, words)
+        data.kernels[dofs] = _numbers(vl, ["0" if w == DEFAULT else w for w in words])   # '/': no term
     if not first:
         where = cur.peek() or head
         raise where.error("NRETij", f"expected at least one 'NRETij IDOF_A IDOF_B' block after {ELEMENTS!r}")
