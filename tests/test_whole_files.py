@@ -121,11 +121,11 @@ def simo_whole(tmp_path, scale=1.0, units="m s kg 9.81 1025.0 0.00125 1.188e-6 1
 
 def simo_loads(data):
     """Acceleration load and memory loads of both sides over a few steps."""
-    c = Coupling(data)
+    c = Coupling.from_deck(data)
     out = [c.acceleration_load(s, MOTION.acceleration) for s in c.sides]
     for k in range(5):
         v = MOTION.velocity * np.cos(0.3 * k)
-        out += [c.advance(s, 0.07, v) for s in c.sides]
+        out += [c.memory[s].advance(0.07, v) for s in c.sides]
     return np.array(out)
 
 
