@@ -171,7 +171,7 @@ static int inner_path(char *out, size_t size) {
 #define MINIMUM_PYTHON "3.10"
 #define MINIMUM_PYTHON_TUPLE "3, 10"
 #define HOWTO "Set HYDROFMU_PYTHON to a Python >= " MINIMUM_PYTHON " interpreter (or venv python) " \
-    "that has numpy and scipy and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
+    "that has numpy (and scipy for convolution memory) and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
 
 /* Run in the new interpreter: sys._hydrofmu_check = '' when usable, else why not. */
 static const char CHECK[] =
@@ -308,13 +308,12 @@ static int start_python(const char *self) {
             return 0;
         }
     }
-    if (!api.IsInitialized()) {
-        /* the program name makes Python find its prefix, venv and site-packages as when run;
-           it must stay valid while Python runs: never freed */
-        wchar_t *name = api.DecodeLocale(py.exe, NULL);
-        if (name) api.SetProgramName(name);
-        api.InitializeEx(0); /* 0: leave the host's signal handlers alone */
-    }
+    if (api.IsInitialized()) return 1; /* the host's own Python, loaded privately: used as it is */
+    /* the program name makes Python find its prefix, venv and site-packages as when run;
+       it must stay valid while Python runs: never freed */
+    wchar_t *name = api.DecodeLocale(py.exe, NULL);
+    if (name) api.SetProgramName(name);
+    api.InitializeEx(0); /* 0: leave the host's signal handlers alone */
     api.RunSimpleString(CHECK);
     void *msg = api.SysGetObject("_hydrofmu_check");
     const char *text = msg ? api.AsUTF8(msg) : NULL;
