@@ -11,6 +11,7 @@ import sys
 import time
 from pathlib import Path
 
+import dask
 import numpy as np
 import pandas as pd
 import pytest
@@ -29,8 +30,10 @@ OUTPUTS = ["barge_dynamics.position[1]", "barge_dynamics.position[2]", "barge.fo
 
 @pytest.fixture(scope="module")
 def client():
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
+    # a task whose worker dies is given up at once (KilledWorker), for the lost-worker test
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
     c = Client(cluster)
     yield c
     c.close()
@@ -52,8 +55,13 @@ def test_batch_equals_single_runs(client, tmp_path):
 "run.substep" = 0.05
 "environment.current_speed" = 0.8
 """)
-    table = run_batch(cases, tmp_path / "out", client=client, progress=False)
+    # through the scheduler's address, as `--scheduler ADDRESS` does
+    table = run_batch(cases, tmp_path / "out", scheduler=client.scheduler.address, progress=False)
     assert len(table) == 5 and (table["status"] == "ok").all(), table[["status", "error"]]
+    # the workers ran the FMUs they were sent, unpacked in their own folders, not the build's
+    shipped = client.run(lambda dask_worker: sorted(
+        p.parent.name for p in Path(dask_worker.local_directory).glob("hydrofmu-batch/*/manifest.json")))
+    assert set().union(*map(set, shipped.values())) == set(table["build"])
     # the four exposed-knob cases share one build, the substep case has its own
     assert table["build"].iloc[:4].nunique() == 1 and table["build"].iloc[4] != table["build"].iloc[0]
     assert len(list((tmp_path / "out" / "builds").iterdir())) == 2
@@ -131,6 +139,38 @@ def test_killed_batch_reruns_only_missing_cases(client, tmp_path):
     again = run_batch(cases, out, client=client, progress=False, log=logs.append)
     assert {p.name: json.loads(p.read_text()) for p in out.glob("cases/*.json")} == after
     pd.testing.assert_frame_equal(again, table)
+
+
+# on the workers: the co-simulation of a case with barge.g = 9.0001 kills its worker process
+KILLER = """
+import os, hydrofmu.cosim.master as m
+if not hasattr(m, "_real_run"):
+    m._real_run = m.run
+def _run(folder, **kw):
+    if (kw.get("parameters") or {}).get("barge.g") == 9.0001:
+        os._exit(3)
+    return m._real_run(folder, **kw)
+m.run = _run
+"""
+HEAL = """
+import hydrofmu.cosim.master as m
+m.run = getattr(m, "_real_run", m.run)
+"""
+
+
+def test_lost_worker_is_recorded_and_rerun(client, tmp_path):
+    cases = case_file(tmp_path, '[matrix]\n"barge.g" = [9.81, 9.0001, 9.80]\n', stop=5.0)
+    client.run(exec, KILLER, {})
+    try:
+        table = run_batch(cases, tmp_path / "out", client=client, progress=False)
+    finally:
+        client.run(exec, HEAL, {})
+    assert list(table["status"]) == ["ok", "lost", "ok"]
+    assert "KilledWorker" in table["error"].iloc[1]
+    client.wait_for_workers(2, timeout=60)   # the nanny restarts the dead worker
+    again = run_batch(cases, tmp_path / "out", client=client, progress=False)
+    assert (again["status"] == "ok").all() and list(again["case"]) == list(table["case"])
+    assert again["barge_dynamics.position[1].max"].iloc[1] > 0
 
 
 def test_case_file_errors(tmp_path):

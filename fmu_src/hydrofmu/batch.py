@@ -412,7 +412,7 @@ def _open_client(client, scheduler, workers):
         c = Client(scheduler)
         return c, [c]
     cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=":0", silence_logs=logging.ERROR)
     c = Client(cluster)
     return c, [c, cluster]
 
@@ -513,7 +513,8 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
                 window = window or max(2, 2 * threads)
             shared = variants.builds[variant.id]
             if shared.blob is None:   # the FMUs go to the workers once per build, as bytes
-                shared.blob = client_.scatter([_blob(shared)], hash=False)[0]   # (a dict would scatter by key)
+                # on every worker: a worker lost takes no build with it (a dict would scatter by key)
+                shared.blob = client_.scatter([_blob(shared)], hash=False, broadcast=True)[0]
             while len(inflight) >= window:
                 _collect(next(ac), inflight, record)
             future = client_.submit(run_case, task, shared.blob, key=f"case-{cid}-{token}", pure=False)
@@ -525,7 +526,7 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
         for c in closing:
             c.close()
         bar.close()
-    return assemble(out, ids, batch)
+    return assemble_table(out, ids, batch)
 
 
 def _collect(future, inflight, record):
@@ -553,7 +554,7 @@ def read_series(out, case):
     return pd.read_parquet(Path(out) / "series" / f"{case}.parquet")
 
 
-def assemble(out, ids, batch):
+def assemble_table(out, ids, batch):
     """The batch table from the per-case files: one row per case (knobs, status, wall time,
     statistics, error, case id, build id); written as cases.csv, cases.parquet and the plot."""
     import pandas as pd

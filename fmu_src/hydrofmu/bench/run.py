@@ -12,6 +12,8 @@ Parts (each also callable alone, see ``PARTS``):
 - bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 - errors: time to report one bad number near the end of a 50 MB deck against reading it
   good (``robust``)
+- batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
+  overhead per case (``batch_cost``)
 
 ``quick`` shrinks every part (for a smoke run); the figures in the README come from a full run.
 """
@@ -214,9 +216,22 @@ def part_errors(out, quick):
             f"the good deck reads in {r['good_s']:.2f} s (ratio {r['ratio']:.2f}, best of 2, side by side)"]
 
 
+def part_batch(out, quick):
+    from . import batch_cost
+    rows, s = batch_cost.measure(out / "batch", cases=4 if quick else 16, stop=10.0 if quick else 60.0,
+                                 rounds=2 if quick else 3)
+    write_csv(out / "batch.csv", rows)
+    verdict = (f"too noisy (spread between rounds {100 * s['spread']:.0f} % > {100 * batch_cost.NOISY:.0f} %): "
+               "figures indicative only; " if s["noisy"] else "")
+    return [f"{verdict}speed-up 1 → 2 workers: {s['speedup']:.2f}× ({rows[0]['cases']} cases of "
+            f"{s['case_s']:.2f} s each on one worker)",
+            f"dispatch overhead per case: {1e3 * s['overhead_s']:.0f} ms = {100 * s['share']:.1f} % of a case's "
+            f"run time; fixed cost of a batch (plan, table, plot): {s['fixed_s']:.2f} s"]
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "stability": part_stability, "bem": part_bem,
-         "errors": part_errors}
+         "errors": part_errors, "batch": part_batch}
 
 
 def main(out, parts=None, quick=False, log=print):
