@@ -11,8 +11,18 @@ Bad input values never raise into the host: the slave logs an error and fmi2DoSt
 returns False, which hydrofmu's binary shim reports as fmi2Error.
 """
 import math
+import os
+import sys
 
-import numpy as np
+if "numpy" not in sys.modules:
+    # A host without numpy of its own (a native FMI host): BLAS starts here, one thread per
+    # process.  A host's parallelism is across FMUs; these settings only take effect before
+    # numpy loads, and a Python host's numpy is its own business (the slaves make no BLAS
+    # call big enough to thread: no fit at instantiation, 6×6-sized products per step).
+    for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_name, "1")
+
+import numpy as np  # noqa: E402
 from pythonfmu import Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
@@ -122,9 +132,12 @@ class ArraySlave(Fmi2Slave):
         return Motion(v[slices[0]], v[slices[1]], v[slices[2]], acc)
 
     def env(self):
-        v = self.values
-        speed, direction = (v[self.current] if self.current else (0.0, 0.0))
-        return Env(v[self.rho], v[self.g], speed, direction)
+        """Env of the current values (the same object while they do not change)."""
+        key = self.values[[self.rho, self.g]].tolist() + (self.values[self.current].tolist() if self.current
+                                                          else [0.0, 0.0])
+        if key != getattr(self, "_env_key", None):
+            self._env_key, self._env = key, Env(*key)
+        return self._env
 
     def finish_registration(self):
         self.values = np.array(self._start, dtype=float)
