@@ -232,6 +232,16 @@ def assemble(scene) -> System:
     return System(loads + joints + dynamics, dyn_of, indicators)
 
 
+def fit_memories(couplings):
+    """Realise every state-space coupling's kernels once and store the fits in the coupling
+    (``HydroCoupling.fits``, carried by the FMU descriptions that hold it): instantiation
+    then only loads them.  The build calls this, not ``assemble``: a batch assembles every
+    case to tell its variants apart and must not pay the fits for it."""
+    for c in couplings:
+        if c.method == "state_space" and c.kernels and not c.fits:
+            c.fits = [d.Fit(i, j, f.A, f.B, f.C, f.error) for (i, j), f in sorted(c.model().fits.items())]
+
+
 def notes(scene, system):
     """Build-time lines for the user: every cross coupling's stability indicator (with a
     warning where explicit coupling diverges) and every state-space fit's order and error."""

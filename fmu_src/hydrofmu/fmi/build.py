@@ -13,6 +13,7 @@ build leaves nothing half-written.
 import hashlib
 import importlib
 import json
+import marshal
 import shutil
 import sys
 import tempfile
@@ -25,18 +26,39 @@ from . import model_description
 from ..errors import InputError
 from .ssp import write_ssp
 from .. import description
-from ..assembly import assemble, notes
+from ..assembly import assemble, fit_memories, notes
 
 PACKAGE = Path(__file__).resolve().parents[1]
+# What a slave imports, and all the FMU runtime holds: the physics kernels, the slaves, the
+# typed description and the errors (no scene loader, deck readers, masters or benchmarks).
+RUNTIME = ("errors.py", "description.py", "physics", "fmi/__init__.py", "fmi/slave.py")
+RUNTIME_INIT = '"""hydrofmu FMU runtime: physics kernels, slaves, typed description, errors."""\n'
+
+
+def runtime_files():
+    """The runtime's source files, relative to the package."""
+    out = []
+    for item in RUNTIME:
+        path = PACKAGE / item
+        out += sorted(path.rglob("*.py")) if path.is_dir() else [path]
+    return [f.relative_to(PACKAGE) for f in out]
 
 
 def runtime_name():
-    """'hydrofmu_rt_<hash>': the package copy's name, from the hash of its sources."""
-    h = hashlib.sha256()
-    for f in sorted(PACKAGE.rglob("*.py")):
-        h.update(f.relative_to(PACKAGE).as_posix().encode())
-        h.update(f.read_bytes())
+    """'hydrofmu_rt_<hash>': the runtime copy's name, from the hash of its sources."""
+    h = hashlib.sha256(RUNTIME_INIT.encode())
+    for f in runtime_files():
+        h.update(f.as_posix().encode())
+        h.update((PACKAGE / f).read_bytes())
     return f"hydrofmu_rt_{h.hexdigest()[:10]}"
+
+
+def copy_runtime(dest):
+    """Copy the runtime into ``dest`` (a package folder of its own)."""
+    for f in runtime_files():
+        (dest / f).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(PACKAGE / f, dest / f)
+    (dest / "__init__.py").write_text(RUNTIME_INIT)
 
 
 SCRIPT = '''"""hydrofmu FMU {model_id}: {description}"""
@@ -67,7 +89,7 @@ def build_fmu(instance, workdir, runtime, shim=True):
     stage = workdir / "stage" / model_id
     stage.mkdir(parents=True)
     rt = stage / runtime
-    shutil.copytree(PACKAGE, rt, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "*.c", "*.so"))
+    copy_runtime(rt)
     config = description.write(instance.fmu, stage)
     script = stage / f"{model_id}.py"
     script.write_text(SCRIPT.format(model_id=model_id, runtime=runtime, slave=SLAVES[type(instance.fmu)],
@@ -91,12 +113,29 @@ def build_fmu(instance, workdir, runtime, shim=True):
     return Path(fmu), slave
 
 
+def bytecode(source, name):
+    """Bytecode of a module's source for this interpreter, as an unchecked-hash .pyc: valid
+    whatever the extracted file's time stamp (FMU hosts unzip anew each time, so without it
+    every instantiation compiles the runtime); other Python versions ignore it (their own
+    cache tag) and compile the source."""
+    import importlib.util
+    code = compile(source, name, "exec", dont_inherit=True)
+    flags = (0b01).to_bytes(4, "little")   # hash-based, not checked against the source
+    return importlib.util.MAGIC_NUMBER + flags + importlib.util.source_hash(source) + marshal.dumps(code)
+
+
 def rewrite_model_description(fmu, slave):
-    """Replace modelDescription.xml in the FMU zip (via a temporary copy)."""
+    """Replace modelDescription.xml in the FMU zip (via a temporary copy) and add the
+    bytecode of every Python source in its resources (``bytecode``)."""
     tmp = Path(str(fmu) + ".tmp")
+    tag = sys.implementation.cache_tag
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for item in src.infolist():
             data = src.read(item)
+            name = item.filename
+            if name.startswith("resources/") and name.endswith(".py") and tag:
+                folder, _, module = name.rpartition("/")
+                dst.writestr(f"{folder}/__pycache__/{module[:-3]}.{tag}.pyc", bytecode(data, name))
             if item.filename == "modelDescription.xml":
                 data = model_description.complete(data, slave.units, slave.dependencies)
             dst.writestr(item, data)
@@ -162,6 +201,7 @@ def build_scene(scene, outdir, shim=True, log=print, check=False):
     outdir = Path(outdir)
     target = outdir / scene.name
     system = assemble(scene)
+    fit_memories(scene.couplings)   # once, here: the FMUs load the stored fits
     runtime = runtime_name()
     for line in notes(scene, system):
         log(line)
