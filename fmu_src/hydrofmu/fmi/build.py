@@ -10,6 +10,7 @@ needs only numpy.  What each FMU holds comes from ``hydrofmu.assembly``: this mo
 Everything is built in a temporary folder and moved into place at the end, so a failed
 build leaves nothing half-written.
 """
+import ast
 import hashlib
 import importlib
 import json
@@ -29,19 +30,48 @@ from .. import description
 from ..assembly import assemble, fit_memories, notes
 
 PACKAGE = Path(__file__).resolve().parents[1]
-# What a slave imports, and all the FMU runtime holds: the physics kernels, the slaves, the
-# typed description and the errors (no scene loader, deck readers, masters or benchmarks).
-RUNTIME = ("errors.py", "description.py", "physics", "fmi/__init__.py", "fmi/slave.py")
+# The FMU runtime is what the slaves import, and nothing else (no scene loader, deck
+# readers, masters or benchmarks): the closure of the package-relative imports of
+# fmi/slave.py (every one, module level or not), found in the sources.
+RUNTIME_ENTRY = "fmi/slave.py"
 RUNTIME_INIT = '"""hydrofmu FMU runtime: physics kernels, slaves, typed description, errors."""\n'
 
 
+def _module_file(name):
+    """The file of package module ``name`` (dotted, relative to the package), or None."""
+    path = PACKAGE.joinpath(*name.split(".")) if name else PACKAGE
+    if path.with_suffix(".py").is_file():
+        return path.with_suffix(".py")
+    return path / "__init__.py" if (path / "__init__.py").is_file() else None
+
+
 def runtime_files():
-    """The runtime's source files, relative to the package."""
-    out = []
-    for item in RUNTIME:
-        path = PACKAGE / item
-        out += sorted(path.rglob("*.py")) if path.is_dir() else [path]
-    return [f.relative_to(PACKAGE) for f in out]
+    """The runtime's source files, relative to the package (sorted)."""
+    entry = PACKAGE / RUNTIME_ENTRY
+    seen, todo = set(), [entry] + [d / "__init__.py" for d in entry.parents if PACKAGE in d.parents]
+    while todo:
+        f = todo.pop()
+        rel = f.relative_to(PACKAGE)
+        if rel in seen:
+            continue
+        seen.add(rel)
+        here = list(rel.parent.parts)
+        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.ImportFrom) and node.level):
+                continue
+            base = here[:len(here) - (node.level - 1)] if node.level > 1 else here
+            mod = ".".join(base + ([node.module] if node.module else []))
+            parts = mod.split(".") if mod else []
+            for k in range(len(parts) + 1):   # the packages on the way in
+                init = _module_file(".".join(parts[:k]))
+                if init is not None and init.name == "__init__.py" and k < len(parts):
+                    todo.append(init)
+            for target in [mod] + [f"{mod}.{a.name}" if mod else a.name for a in node.names]:
+                found = _module_file(target)
+                if found is not None:
+                    todo.append(found)
+    seen.discard(Path("__init__.py"))   # the runtime has an __init__ of its own
+    return sorted(seen)
 
 
 def runtime_name():
