@@ -15,6 +15,7 @@ from ctypes import c_double
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from fmpy.fmi1 import FMICallException
 
 from hydrofmu.decks.simo import read_couplings
 from hydrofmu.physics.coupling import Coupling
@@ -880,8 +881,9 @@ def test_bad_step_is_error_then_recovers(ext, kind, step):
 
 @pytest.mark.parametrize("kind, name", [("hull", "velocity[2]"), ("hitch", "B.velocity[1]")])
 def test_input_fixed_before_the_step_is_not_an_error(ext, kind, name):
-    """A master that reads outputs while an input is NaN, then corrects the input before
-    stepping (e.g. an iteration), must get fmi2OK: at fmi2DoStep every input is finite."""
+    """A master that reads outputs while an input is NaN gets fmi2Error from fmi2GetReal (a
+    log line names the input); once it corrects the input before stepping (e.g. an
+    iteration), fmi2DoStep returns fmi2OK: at fmi2DoStep every input is finite."""
     folder, _ = ext
     messages = []
     fmu = open_fmu(folder, kind, messages)
@@ -889,7 +891,9 @@ def test_input_fixed_before_the_step_is_not_an_error(ext, kind, name):
         _good_inputs(kind, fmu, 0)
         good = fmu.slave.getReal([fmu.vr[name]])
         fmu.slave.setReal([fmu.vr[name]], [np.nan])
-        outputs(fmu)                                    # evaluated with the NaN
+        with pytest.raises(FMICallException) as exc:   # evaluated with the NaN
+            outputs(fmu)
+        assert exc.value.status == 3 and [m for st, m in messages if st == 3 and name in m], messages
         fmu.slave.setReal([fmu.vr[name]], good)
         assert do_step(fmu, 0.0, 0.1) == 0, messages
     finally:

@@ -85,7 +85,7 @@ def test_forces_through_fmpy_equal_kernels(demo_build):
     effects = [make_effect(e.type, e.name, e.data) for e in scene.bodies["barge"].effects]
     fmu = Fmu(demo_build / "moored_barge_barge.fmu")
     try:
-        for _ in range(20):
+        for k in range(20):
             motion = Motion(rng.normal(size=3), rng.uniform(-0.4, 0.4, 3) + [0, 0, rng.uniform(-4, 4)],
                             rng.normal(size=6) * [1, 1, 0.3, 0.05, 0.05, 0.05])
             env = Env(1025.0, 9.81, rng.uniform(0, 2), rng.uniform(-360, 720))
@@ -98,7 +98,7 @@ def test_forces_through_fmpy_equal_kernels(demo_build):
             np.testing.assert_allclose(fmu.get("viscous_drag.force"), expected[0], rtol=1e-12, atol=1e-9)
             np.testing.assert_allclose(fmu.get("current_polar.force"), expected[1], rtol=1e-12, atol=1e-9)
             np.testing.assert_allclose(fmu.get("force"), expected[0] + expected[1], rtol=1e-12, atol=1e-9)
-            fmu.slave.doStep(0.0, 0.1)
+            fmu.slave.doStep(0.1 * k, 0.1)
     finally:
         fmu.close()
 
@@ -114,8 +114,8 @@ def test_bad_input_gives_fmi2error_and_a_log_line(demo_build, bad):
             fmu.slave.doStep(0.1, 0.1)
         assert exc.value.status == 3  # fmi2Error
         assert any(status == 3 and "velocity[2]" in msg and "not finite" in msg for status, msg in messages)
-        fmu.set("velocity", [0.5, 0, 0, 0, 0, 0])  # the instance is still usable
-        fmu.slave.doStep(0.2, 0.1)
+        fmu.set("velocity", [0.5, 0, 0, 0, 0, 0])  # the instance is still usable: the step again
+        fmu.slave.doStep(0.1, 0.1)
         assert np.all(np.isfinite(fmu.get("force")))
         with pytest.raises(FMICallException):
             fmu.slave.doStep(0.3, -0.1)  # a non-positive step is an error too

@@ -438,7 +438,18 @@ typedef struct {
     int logging;                  /* host's loggingOn */
     size_t ncat;                  /* host's categories; none = all */
     char **cats;                  /* one block: ncat pointers, then the strings */
+    fmi2Status worst;             /* worst status logged during the current call */
 } Shim;
+
+/*
+ * The status that tells the truth: pythonfmu 0.7 can only report a Python callback's
+ * trouble as fmi2Fatal (an exception) or, for fmi2DoStep, as fmi2Discard.  hydrofmu's
+ * slaves never raise: they log an error instead, and a call that logged an error
+ * returns fmi2Error (never less).
+ */
+static fmi2Status truthful(const Shim *s, fmi2Status st) {
+    return st < fmi2Error && s->worst >= fmi2Error ? fmi2Error : st;
+}
 
 /* Should a message of this status and category reach the host? */
 static int wanted(const Shim *s, fmi2Status st, fmi2String cat) {
@@ -459,7 +470,8 @@ static void shim_logger(fmi2ComponentEnvironment e, fmi2String name, fmi2Status 
                         fmi2String cat, fmi2String msg, ...) {
     static const char *by_status[] = {"logStatusOK", "logStatusWarning", "logStatusDiscard",
                                       "logStatusError", "logStatusFatal", "logStatusPending"};
-    const Shim *s = e;
+    Shim *s = e;
+    if (s && st > s->worst && st <= fmi2Fatal) s->worst = st;
     /* never hand the host a NULL string (pythonfmu reports exceptions with no category) */
     if (!cat) cat = st >= fmi2OK && st <= fmi2Pending ? by_status[st] : "";
     if (!name) name = "";
@@ -496,11 +508,13 @@ static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
 #define FORWARD(name, params, args)                       \
     EXPORT fmi2Status fmi2##name params {                 \
         if (!ready() || !c) return fmi2Error;             \
-        c = ((Shim *)c)->inner;                           \
+        Shim *s_ = c;                                     \
+        c = s_->inner;                                    \
+        s_->worst = fmi2OK;                               \
         GIL_TAKE;                                         \
         fmi2Status st_ = inner.name args;                 \
         GIL_GIVE;                                         \
-        return st_;                                       \
+        return truthful(s_, st_);                         \
     }
 FMI_STATUS_FUNCS(FORWARD)
 #undef FORWARD
@@ -605,8 +619,10 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n,
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior) {
     if (!ready() || !c) return fmi2Error;
+    Shim *sh = c;
+    sh->worst = fmi2OK;
     GIL_TAKE;
-    fmi2Status s = inner.DoStep(((Shim *)c)->inner, t, h, noPrior);
+    fmi2Status s = inner.DoStep(sh->inner, t, h, noPrior);
     GIL_GIVE;
-    return s == fmi2Discard ? fmi2Error : s;
+    return truthful(sh, s == fmi2Discard ? fmi2Error : s);
 }

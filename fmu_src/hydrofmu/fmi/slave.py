@@ -7,9 +7,14 @@ the state they expose, with their unit and, for outputs, the inputs they depend 
 
 Load outputs are direct feedthrough: setting an input marks the outputs stale, and the
 next fmi2GetReal (or fmi2DoStep) evaluates the kernels with the inputs as they are now.
-Bad input values never raise into the host: the slave logs an error and fmi2DoStep
-returns False, which hydrofmu's binary shim reports as fmi2Error.
+Nothing raises into the host: pythonfmu 0.7 turns any Python exception in a callback into
+fmi2Fatal, so every entry point is ``guarded``: a failure, a non-finite input or output,
+a parameter set after initialization, a time jump, a bad FMU state is one error log line
+naming the variable, and hydrofmu's binary shim returns fmi2Error for any call that
+logged an error (and for fmi2DoStep's False, which pythonfmu reports as fmi2Discard).
 """
+import functools
+import json
 import math
 import os
 import sys
@@ -42,6 +47,22 @@ LIN_ROT = {
 MASS_UNITS = [["kg"] * 3 + ["kg.m"] * 3] * 3 + [["kg.m"] * 3 + ["kg.m2"] * 3] * 3
 
 
+def guarded(fallback=None):
+    """An FMI entry point that never raises: an exception is logged as an error (the shim
+    then returns fmi2Error) and ``fallback(self, *args)`` is returned instead."""
+    def wrap(method):
+        @functools.wraps(method)
+        def call(self, *args):
+            try:
+                with np.errstate(all="ignore"):   # non-finite results are checked, not warned
+                    return method(self, *args)
+            except Exception as exc:
+                self.fail(f"{method.__name__}: {type(exc).__name__}: {exc}")
+                return fallback(self, *args) if fallback else None
+        return call
+    return wrap
+
+
 class ArraySlave(Fmi2Slave):
     """Base slave: Reals in one array, units and output dependencies recorded."""
 
@@ -55,6 +76,9 @@ class ArraySlave(Fmi2Slave):
         self.units = {}         # variable name -> unit
         self.dependencies = {}  # output name -> input names
         self.error = None       # message of a bad input seen since the last step
+        self._inputs, self._params, self._outputs = [], [], []   # value references by causality
+        self.running = False    # after exit_initialization_mode: parameters are fixed
+        self.next_time = None   # the communication point the next fmi2DoStep must start from
         self._finite_idx = {}   # check_finite: input slices -> their value indices
 
     # -- registration ------------------------------------------------------------------
@@ -70,6 +94,8 @@ class ArraySlave(Fmi2Slave):
         elif causality == Fmi2Causality.calculatedParameter:
             kw.update(variability=Fmi2Variability.fixed, initial=Fmi2Initial.calculated)
         self.register_variable(Real(name, **kw), nested=False)
+        {Fmi2Causality.input: self._inputs, Fmi2Causality.parameter: self._params,
+         Fmi2Causality.output: self._outputs}.get(causality, []).append(vr)
         if unit:
             self.units[name] = unit
         return vr
@@ -141,6 +167,8 @@ class ArraySlave(Fmi2Slave):
 
     def finish_registration(self):
         self.values = np.array(self._start, dtype=float)
+        self.output_vrs = np.array(self._outputs, dtype=int)
+        self.settable = set(self._inputs) | set(self._params)
 
     def depends(self, outputs, inputs):
         names = [self.vars[vr].name for s in inputs for vr in range(s.start, s.stop)]
@@ -149,15 +177,88 @@ class ArraySlave(Fmi2Slave):
                 self.dependencies[self.vars[vr].name] = names
 
     # -- FMI ---------------------------------------------------------------------------
+    def fail(self, message):
+        """Log one error line for the host (the shim turns the call's status into fmi2Error)."""
+        self.log(f"{self.instance_name}: {message}", Fmi2Status.error)
+
+    @guarded()
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.next_time = float(start_time)
+
+    @guarded()
+    def enter_initialization_mode(self):
+        pass
+
+    @guarded()
+    def exit_initialization_mode(self):
+        self.start_physics()
+        self.running = True
+
+    def start_physics(self):
+        pass
+
+    @guarded()
+    def terminate(self):
+        pass
+
+    @guarded(lambda self, vrs: [math.nan] * len(vrs))
     def get_real(self, vrs):
         if self.stale:
             self.evaluate()
+        if self.error is not None:   # kept: the next fmi2DoStep fails on it too
+            self.fail(self.error)
+        else:
+            self.check_outputs(vrs)
         return self.values[vrs].tolist()
 
+    @guarded()
     def set_real(self, vrs, values):
+        fixed = [vr for vr in vrs if vr not in self.settable or (self.running and vr in self._params)]
+        if fixed:
+            var = self.vars[fixed[0]]
+            why = ("a parameter, fixed after initialization" if var.causality == Fmi2Causality.parameter
+                   else f"not settable ({var.causality.name})")
+            self.fail(f"cannot set {var.name}: {why}")
+            return
         self.values[vrs] = values
         self.stale = True
         self.error = None   # new inputs: the next evaluation checks them afresh
+
+    def check_outputs(self, vrs=None):
+        """Log an error naming the first non-finite value among ``vrs`` (default: every
+        output); True when all are finite."""
+        vrs = self.output_vrs if vrs is None else vrs
+        out = self.values[vrs]
+        if math.isfinite(out.sum()):
+            return True
+        var = self.vars[int(np.asarray(vrs)[np.argmin(np.isfinite(out))])]
+        self.fail(f"{var.causality.name} {var.name} = {self.values[var.value_reference]} is not finite")
+        return False
+
+    # other types: hydrofmu has only Reals; an unknown reference is an error, not a crash
+    @guarded(lambda self, vrs: [0] * len(vrs))
+    def get_integer(self, vrs):
+        return super().get_integer(vrs)
+
+    @guarded(lambda self, vrs: [False] * len(vrs))
+    def get_boolean(self, vrs):
+        return super().get_boolean(vrs)
+
+    @guarded(lambda self, vrs: [""] * len(vrs))
+    def get_string(self, vrs):
+        return super().get_string(vrs)
+
+    @guarded()
+    def set_integer(self, vrs, values):
+        return super().set_integer(vrs, values)
+
+    @guarded()
+    def set_boolean(self, vrs, values):
+        return super().set_boolean(vrs, values)
+
+    @guarded()
+    def set_string(self, vrs, values):
+        return super().set_string(vrs, values)
 
     def check_finite(self, slices):
         """Record an error naming the first non-finite input; True if all are finite."""
@@ -175,20 +276,30 @@ class ArraySlave(Fmi2Slave):
                 return False
         return True
 
+    @guarded(lambda self, *_: False)
     def do_step(self, current_time, step_size):
+        expected = self.next_time
+        if not (step_size > 0 and np.isfinite(step_size)):
+            self.error = f"communication step {step_size} must be positive and finite"
+        elif expected is not None and abs(current_time - expected) > 1e-6 * step_size + 1e-12 * abs(expected):
+            self.error = (f"communication point {current_time!r} is not where the last step ended "
+                          f"({expected!r}); restore an FMU state (fmi2SetFMUstate) to go back or forward")
         try:
-            if not (step_size > 0 and np.isfinite(step_size)):
-                self.error = f"communication step {step_size} must be positive and finite"
             if self.stale and self.error is None:
                 self.evaluate()
             if self.error is None:
+                if not self.check_outputs():      # logged: the step starts from non-finite outputs
+                    return False
                 self.step_physics(current_time, step_size)
+                if not self.stale and not self.check_outputs():
+                    return False
         except Exception as exc:  # never let a Python exception reach the C host
             self.error = f"{type(exc).__name__}: {exc}"
         if self.error is not None:
-            self.log(f"{self.instance_name} at t={current_time}: {self.error}", Fmi2Status.error)
+            self.fail(f"at t={current_time}: {self.error}")
             self.error = None
             return False
+        self.next_time = current_time + step_size
         return True
 
     def evaluate(self):
@@ -197,14 +308,36 @@ class ArraySlave(Fmi2Slave):
     def step_physics(self, t, dt):
         pass
 
-    # FMU state: the value array plus whatever the slave's physics holds.
+    # FMU state: the value array, the time and whatever the slave's physics holds, as plain
+    # JSON values (fmi2SerializeFMUstate writes it as JSON).
+    @guarded(lambda self: {"invalid": "the FMU state could not be taken"})
     def _get_fmu_state(self):
-        return {"values": self.values.tolist(), "physics": self.physics_state()}
+        return _plain({"values": self.values, "physics": self.physics_state(), "next_time": self.next_time,
+                       "running": self.running})
 
+    @guarded()
     def _set_fmu_state(self, state):
+        if not isinstance(state, dict) or "invalid" in state or len(state.get("values", ())) != self.values.size:
+            why = state.get("invalid") if isinstance(state, dict) and "invalid" in state else "wrong size or kind"
+            self.fail(f"fmi2SetFMUstate: not a state of this FMU ({why})")
+            return
         self.values[:] = state["values"]
         self.set_physics_state(state["physics"])
+        self.next_time, self.running = state["next_time"], state["running"]
         self.stale = True
+        self.error = None
+
+    @staticmethod
+    def _fmu_state_to_bytes(state):
+        return json.dumps(state).encode("utf-8")
+
+    @staticmethod
+    def _fmu_state_from_bytes(data):
+        try:
+            state = json.loads(data.decode("utf-8"))
+            return state if isinstance(state, dict) else {"invalid": "not a hydrofmu FMU state"}
+        except (UnicodeDecodeError, ValueError):   # garbage bytes: refused by _set_fmu_state
+            return {"invalid": "the bytes are not a serialized hydrofmu FMU state"}
 
     def physics_state(self):
         return None
@@ -259,7 +392,7 @@ class LoadSlave(ArraySlave):
         self.finish_registration()
         self.stale = True
 
-    def exit_initialization_mode(self):
+    def start_physics(self):
         for c in self.couplings:
             side = c["cfg"]
             if side.coupling.kernels:
@@ -338,7 +471,7 @@ class DynamicsSlave(ArraySlave):
         self.solver = None
         self.stale = False
 
-    def exit_initialization_mode(self):
+    def start_physics(self):
         v = self.values
         bodies = []
         for part in self.parts:
@@ -388,14 +521,15 @@ class DynamicsSlave(ArraySlave):
         if not hasattr(self, "bodies"):
             return None
         last = getattr(self, "last_loads", None)
-        return {"bodies": [_plain(b.state()) for b in self.bodies],
+        return {"bodies": [b.state() for b in self.bodies],
                 "last_loads": None if last is None else (last[0].copy(), last[1])}
 
     def set_physics_state(self, state):
         if state is not None:
             for body, s in zip(self.bodies, state["bodies"]):
                 body.set_state(s)
-            self.last_loads = state["last_loads"]
+            last = state["last_loads"]
+            self.last_loads = None if last is None else (np.asarray(last[0], dtype=float), last[1])
 
 
 class ConnectorSlave(ArraySlave):
