@@ -127,7 +127,7 @@ def build_fmu(instance, workdir, runtime, shim=True):
     saved_path = list(sys.path)
     try:
         fmu = FmuBuilder.build_FMU(script, dest=workdir / "fmus", project_files=[rt, config],
-                                   canGetAndSetFMUstate=True)
+                                   canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         slave = getattr(importlib.import_module(model_id), model_id)(
             instance_name="introspect", resources=str(stage))
     finally:
