@@ -3,6 +3,7 @@ added mass and quadratic drag at large steps — linear theory against in-proces
 the real kernels, and a few points through the FMUs and the fmpy master."""
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -122,7 +123,7 @@ def test_fmu_explicit_added_mass(tmp_path):
     g = fmu_growth(run(folder, stop=5.0, progress=False), 2.0)
     assert g > 1e3
     assert g == pytest.approx(st.added_mass_run(2.0, 0.1, "explicit", n_steps=50), rel=1e-6)
-    with pytest.raises(Exception, match=r"fmi2DoStep failed .*\(error\).* is not finite"):
+    with pytest.raises(Exception, match=r"fmi2(DoStep|GetReal) failed .*\(error\).* is not finite"):
         run(folder, stop=100.0, progress=False)
 
 
@@ -248,7 +249,7 @@ def test_cross_fmu_pair(tmp_path):
         grown = np.abs(r.motion("a", "velocity", 6)[:, 1]).max()
         assert grown > 1e3
     except Exception as exc:         # overflow to a non-finite input: the FMU reports fmi2Error
-        assert "fmi2DoStep" in str(exc)
+        assert re.search(r"fmi2(DoStep|GetReal) failed", str(exc))
         assert "not finite" in str(exc)           # the FMU's log line, in the one RunError
 
 
@@ -373,5 +374,5 @@ def test_drag_fmu_pair(tmp_path, algorithm):
         r = run(folder, step=h, stop=round(30 * h, 9), algorithm=algorithm, progress=False)
         assert np.abs(2.0 - r["hull_dynamics.velocity[1]"]).max() > 1e3 * 100.0
     except Exception as exc:
-        assert "fmi2DoStep" in str(exc)
+        assert re.search(r"fmi2(DoStep|GetReal) failed", str(exc))
         assert "not finite" in str(exc)           # the FMU's log line, in the one RunError

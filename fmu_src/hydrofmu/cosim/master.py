@@ -346,6 +346,7 @@ _STATUS = {1: "warning", 2: "discard", 3: "error", 4: "fatal"}
 
 def failure(system, exc, t):
     """One line for a failed FMU call: the call, the time and what each FMU logged."""
-    logged = [f"{name}: {msg}" for name, inst in system.instances.items() for msg in inst.errors]
+    logged = [msg if msg.startswith(name) else f"{name}: {msg}" for name, inst in system.instances.items()
+              for msg in inst.errors]
     return f"{exc.function} failed at t = {t:g} s ({_STATUS.get(exc.status, exc.status)})" + (
         ": " + "; ".join(logged) if logged else "")
