@@ -52,3 +52,31 @@ def deck_error_time(folder, megabytes=50.0, rounds=2):
         t_bad = min(t_bad, time.perf_counter() - t0)
     return {"megabytes": good.stat().st_size / 1e6, "good_s": t_good, "bad_s": t_bad,
             "ratio": t_bad / t_good, "error": message, "bad_line": line}
+
+
+def instantiate_cycles(fmu, cycles=10_000, warmup=200):
+    """Resident memory growth [kB per cycle] over ``cycles`` fmi2Instantiate/fmi2FreeInstance
+    pairs of one FMU through fmpy, after ``warmup`` cycles; returns (kB/cycle, seconds)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu))
+    folder = extract(str(fmu))
+
+    def cycle():
+        s = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName="cycle")
+        s.instantiate()
+        s.freeInstance()
+
+    for _ in range(warmup):
+        cycle()
+    before, t0 = _rss(), time.perf_counter()
+    for _ in range(cycles):
+        cycle()
+    return (_rss() - before) / cycles / 1e3, time.perf_counter() - t0
+
+
+def _rss():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096

@@ -92,17 +92,29 @@ def copy_runtime(dest):
 
 
 SCRIPT = '''"""hydrofmu FMU {model_id}: {description}"""
-import ctypes
+# pythonfmu 0.7 executes this file again at every instantiation (in the module's globals,
+# with fresh locals) and keeps for good whatever that creates: the class is defined once,
+# at import, and later runs only bind it again.
+try:
+    {model_id} = _defined
+except NameError:
+    import ctypes
+    import sys
 
-from {runtime}.fmi.slave import {slave}
+    from {runtime}.fmi.slave import {slave}
 
+    class {model_id}({slave}):
+        def __init__(self, **kwargs):
+            # pythonfmu 0.7's loader drops one reference to this module's globals at every
+            # instantiation (PythonFMU issue #228): give it back, or a second instance fails.
+            ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
+            # ... and puts the resources folder in front of sys.path every time: keep one
+            resources = kwargs.get("resources")
+            while sys.path.count(resources) > 1:
+                sys.path.remove(resources)
+            super().__init__(**kwargs)
 
-class {model_id}({slave}):
-    def __init__(self, **kwargs):
-        # pythonfmu 0.7's loader drops one reference to this module's globals at every
-        # instantiation (PythonFMU issue #228): give it back, or a second instance fails.
-        ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
-        super().__init__(**kwargs)
+    _defined = {model_id}
 '''
 
 
