@@ -93,17 +93,16 @@ def copy_runtime(dest):
 
 SCRIPT = '''"""hydrofmu FMU {model_id}: {description}"""
 # pythonfmu 0.7 executes this file again at every instantiation (in the module's globals,
-# with fresh locals) and keeps for good whatever that creates: the class is defined once,
-# at import, and later runs only bind it again.
-try:
-    {model_id} = _defined
-except NameError:
-    import ctypes
-    import sys
+# with fresh locals) and keeps for good whatever that creates: the class is defined once
+# per runtime module (again only when a build in this process reloaded the runtime).
+import ctypes
+import sys
 
-    from {runtime}.fmi.slave import {slave}
+_runtime = globals().get("_runtime")
+if _runtime is None or sys.modules.get("{runtime}.fmi.slave") is not _runtime:
+    from {runtime}.fmi import slave as _slave
 
-    class {model_id}({slave}):
+    class {model_id}(_slave.{slave}):
         def __init__(self, **kwargs):
             # pythonfmu 0.7's loader drops one reference to this module's globals at every
             # instantiation (PythonFMU issue #228): give it back, or a second instance fails.
@@ -114,7 +113,8 @@ except NameError:
                 sys.path.remove(resources)
             super().__init__(**kwargs)
 
-    _defined = {model_id}
+    globals().update({model_id}={model_id}, _runtime=_slave)
+{model_id} = globals()["{model_id}"]
 '''
 
 
