@@ -67,7 +67,7 @@ import math
 
 import numpy as np
 
-from .. import admissible
+from ..admissible import inertia as inertia_problems
 from ..errors import InputError
 from .state import Motion
 
@@ -238,7 +238,7 @@ class RigidBody:
         self.source = str(source)
         self.mass = self._scalar(mass, "mass")
         inertia = self._array(inertia, (3, 3), "inertia")
-        for field, message in admissible.inertia(inertia):
+        for field, message in inertia_problems(inertia):
             raise self._error(field, message)
         self.inertia = inertia
         self.cog = self._array(cog, (3,), "cog")
