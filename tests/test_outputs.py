@@ -29,9 +29,9 @@ def test_robust_limits_clip_a_start_spike_and_say_so():
     y = 50 + t / 10
     y[0] = -700.0
     lo, hi, clipped = robust_limits(t, [y])
-    # settled part t >= 10 s: 51.0..60.0 in 91 samples; 1st/99th percentiles (linear
-    # interpolation at position 0.01·90 = 0.9): 51.09 and 59.91; span 8.82; pad 10 %
-    p_lo, p_hi = 51.0 + 0.9 * 0.1, 60.0 - 0.9 * 0.1
+    # settled part t >= 5 s: 50.5..60.0 in 96 samples; 1st/99th percentiles (linear
+    # interpolation at position 0.01·95 = 0.95): 50.595 and 59.905; span 9.31; pad 10 %
+    p_lo, p_hi = 50.5 + 0.95 * 0.1, 60.0 - 0.95 * 0.1
     pad = 0.1 * (p_hi - p_lo)
     assert lo == pytest.approx(p_lo - pad) and hi == pytest.approx(p_hi + pad)
     assert clipped == (-700.0, 60.0)

@@ -36,11 +36,11 @@ def relative_motion(position, attitude):
     return position - position[0], np.unwrap(attitude, axis=0) - attitude[0]
 
 
-def robust_limits(t, series, settle=0.1, q=1.0, factor=3.0, pad=0.1):
+def robust_limits(t, series, settle=5.0, q=1.0, factor=3.0, pad=0.1):
     """Axis limits that a start transient does not set.
 
     The spread of the settled run is the ``q``..``100 - q`` percentile range of every series
-    after ``t[0] + settle·(t[-1] - t[0])``.  If the whole data span is more than ``factor``
+    after the first ``settle`` seconds (at most the first 10 % of the run).  If the whole data span is more than ``factor``
     times that spread, the limits are the spread widened by ``pad`` of it on each side and
     the data are clipped; otherwise the limits are the whole data span widened by ``pad``.
 
@@ -51,8 +51,8 @@ def robust_limits(t, series, settle=0.1, q=1.0, factor=3.0, pad=0.1):
     series : sequence of (n,) arrays
         The curves of one panel.
     settle, q, factor, pad : float
-        Fraction of the run skipped as start, percentile [%], clipping threshold and
-        padding (fractions of the span).
+        Start skipped [s], percentile [%], clipping threshold and padding (fractions of
+        the span).
 
     Returns
     -------
@@ -68,7 +68,7 @@ def robust_limits(t, series, settle=0.1, q=1.0, factor=3.0, pad=0.1):
     if not finite.any():
         return -1.0, 1.0, None
     lo_all, hi_all = float(data[finite].min()), float(data[finite].max())
-    late = data[:, t >= t[0] + settle * (t[-1] - t[0])]
+    late = data[:, t >= t[0] + min(settle, 0.1 * (t[-1] - t[0]))]
     late = late[np.isfinite(late)]
     lo, hi = (np.percentile(late, [q, 100 - q]) if late.size else (lo_all, hi_all))
     clip = hi_all - lo_all > factor * (hi - lo)
