@@ -64,7 +64,7 @@ def main(argv=None):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import matplotlib.ticker
+    from hydrofmu.cosim.report import plain_log_ticks
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for algorithm, marker in (("jacobi", "s"), ("gauss-seidel", "o")):
         mine = [r for r in rows if r["algorithm"] == algorithm]
@@ -74,10 +74,7 @@ def main(argv=None):
                         xytext=(6, -3 if algorithm == "jacobi" else 5), fontsize=8)
     ax.set(xlabel="wall time [s]", ylabel="position error vs reference [%]",
            title=f"{scene.name}: communication step (labels) against cost, {args.stop:g} s simulated")
-    for axis in (ax.xaxis, ax.yaxis):   # plain numbers on the log axes, not 6×10⁻¹
-        axis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
-        axis.set_minor_locator(matplotlib.ticker.LogLocator(subs=(2, 5)))
-        axis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    plain_log_ticks(ax)   # 0.2, 0.5, 1 rather than 2×10⁻¹
     ax.margins(x=0.15, y=0.1)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()

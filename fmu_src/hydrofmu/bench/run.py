@@ -25,6 +25,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from . import cosim_cost, floor, memory_cost, overhead, radiation_cost, robust, stability  # noqa: E402
 
@@ -69,7 +70,7 @@ def plot_memory_tradeoff(rows, path):
     """Error against cost per evaluator family (convolution: squares, state space: circles),
     each point labelled by its knob, labels kept apart; exact evaluators (error 0) on a
     line of their own at the bottom."""
-    from ..cosim.report import annotate_apart
+    from ..cosim.report import annotate_apart, plain_log_ticks
     errors = [r["error"] for r in rows if r["error"] > 0]
     floor = min(errors) / 10 if errors else 1e-6
     fig, ax = plt.subplots(figsize=(8, 5.5))
@@ -78,7 +79,7 @@ def plot_memory_tradeoff(rows, path):
         ax.loglog([r["cost_us"] for r in mine], [r["error"] or floor for r in mine], marker, color=colour,
                   label={"convolution": "convolution (memory length)", "state_space": "state space (tolerance, order)"}[family])
     ax.axhline(floor, color="0.6", ls=":", lw=1)
-    exact = ax.text(0.01, floor, " error 0 (equal to the reference, the full convolution)", transform=ax.get_yaxis_transform(), ha="left", va="bottom",
+    exact = ax.text(0.01, floor, " error 0 (the reference, or equal to it)", transform=ax.get_yaxis_transform(), ha="left", va="bottom",
                     fontsize=7, color="0.4")
     ax.set_xlabel("cost per step [µs]")
     ax.set_ylabel("force error (normalised RMS, worst component)")
@@ -86,6 +87,14 @@ def plot_memory_tradeoff(rows, path):
     ax.grid(True, which="both", alpha=0.3)
     legend = ax.legend(fontsize=8, loc="upper right")
     ax.margins(x=0.25, y=0.15)
+    plain_log_ticks(ax)
+    if errors:   # no tick between the exact line and the smallest error: the line is 0, not floor
+        lo, hi = ax.get_ylim()
+        keep = lambda ticks: [t for t in ticks if min(errors) / 2 <= t <= hi]
+        ax.set_yticks(keep(ax.get_yticks()) + [floor])
+        ax.set_yticks(keep(ax.get_yticks(minor=True)), minor=True)
+        ax.set_ylim(lo, hi)
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "0" if v == floor else f"{v:g}"))
     fig.tight_layout()
     annotate_apart(ax, [r["cost_us"] for r in rows], [r["error"] or floor for r in rows],
                    [r["evaluator"].replace("convolution ", "conv. ").replace("state_space ", "") for r in rows],
@@ -112,8 +121,9 @@ def part_sweep(out, quick):
     ax.set_title("Two bodies, SIMO interaction: communication step sweep (labels: step [s])")
     ax.grid(True, which="both", alpha=0.3)
     legend = ax.legend(fontsize=8)
+    from ..cosim.report import annotate_apart, plain_log_ticks
+    plain_log_ticks(ax)
     fig.tight_layout()
-    from ..cosim.report import annotate_apart
     annotate_apart(ax, [r["wall_s"] for r in rows], [r["error"] for r in rows], [f"{r['step']:g}" for r in rows],
                    avoid=(legend,))
     fig.savefig(out / "step_sweep.png", dpi=120)

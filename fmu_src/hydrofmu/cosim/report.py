@@ -245,3 +245,13 @@ def annotate_apart(ax, xs, ys, labels, fontsize=7, avoid=()):
         taken.append(box)
         placed.append(ann)
     return placed
+
+
+def plain_log_ticks(ax):
+    """Log axes labelled with plain numbers (0.2, 0.5, 1, 2 …), not 2×10⁻¹."""
+    from matplotlib.ticker import FormatStrFormatter, LogLocator
+    for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+        if scale == "log":
+            axis.set_major_formatter(FormatStrFormatter("%g"))
+            axis.set_minor_locator(LogLocator(subs=(2, 5)))
+            axis.set_minor_formatter(FormatStrFormatter("%g"))
