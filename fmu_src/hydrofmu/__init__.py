@@ -14,10 +14,10 @@ Public API (imported on first use, so ``import hydrofmu`` stays cheap):
 Layout: ``physics`` (pure numpy kernels), ``decks`` (vendor input readers), ``scene``
 (scene files), ``fmi`` (FMU wrapping and building), ``cosim`` (masters).  The package uses
 relative imports only, so a build can embed a renamed copy of it inside each FMU; this
-file imports nothing at load time, so the copy's start-up inside an FMU pays nothing for it.
+file imports nothing at load time, so the copy's start-up inside an FMU pays nothing for it
+(and names no module in an import statement: the names' types are in ``__init__.pyi``).
 """
 from importlib import import_module
-from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
 
@@ -46,18 +46,3 @@ def __getattr__(name):
 def __dir__():
     return sorted(set(globals()) | set(_WHERE))
 
-
-if TYPE_CHECKING:   # for type checkers and IDEs; never executed
-    from .api import build, load_scene, run
-    from .cosim.result import Result, read_csv
-    from .errors import InputError
-    from .physics.coupling import Coupling
-    from .physics.current_polar import CurrentPolar
-    from .physics.joint import BallJoint
-    from .physics.loads import BodyLoads
-    from .physics.lumped import LumpedBody
-    from .physics.memory import Convolution, StateSpace
-    from .physics.rigid_body import CoupledBodies, RigidBody
-    from .physics.state import Env, Motion
-    from .physics.viscous_drag import ViscousDrag
-    from .scene import Scene
