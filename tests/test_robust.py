@@ -269,6 +269,8 @@ def test_cli_bad_run_arguments_before_anything_is_built(tmp_path, args, words):
 def test_cli_run_missing_folder(tmp_path):
     code, line = cli("run", tmp_path / "nowhere")
     assert code == 2 and "nowhere: scene: not a scene .toml nor a built scene folder" in line
+    code, line = cli("validate", tmp_path / "nowhere.fmu")
+    assert code == 2 and "nowhere.fmu: path: no such FMU or folder" in line
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")

@@ -74,6 +74,9 @@ def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
 def validate(paths):
     """fmpy's validation of FMU files (or of every FMU in folders); returns problem count."""
     from fmpy.validation import validate_fmu
+    missing = [p for p in map(Path, paths) if not p.exists()]
+    if missing:
+        raise InputError(missing[0], None, "path", "no such FMU or folder")
     fmus = [f for p in map(Path, paths) for f in (sorted(p.rglob("*.fmu")) if p.is_dir() else [p])]
     problems = 0
     for fmu in fmus:
