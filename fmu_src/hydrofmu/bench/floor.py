@@ -6,7 +6,7 @@ n FMUs, the floor is n of them connected in a ring and run by the same master
 (``cosim.master``, Gauss–Seidel, every output recorded), so every figure below is a multiple
 of what the same master pays for the same number of FMUs that do nothing:
 
-- startup: load, instantiate and initialise every FMU (``master.System`` + ``initialize``)
+- startup: load, instantiate and initialise every FMU (``master.load`` + ``initialize``)
   in a fresh Python process that has imported fmpy and numpy (a host's first FMU pays the
   runtime's imports, as it would);
 - cost per step: the stepping loop of ``master.run`` (startup excluded).
@@ -52,9 +52,9 @@ class hydrofmu_floor(Fmi2Slave):
 
 STARTUP = '''import json, sys, time
 import numpy, fmpy
-from hydrofmu.cosim.master import System
+from hydrofmu.cosim.master import load
 t0 = time.perf_counter()
-system = System(sys.argv[1])
+system = load(sys.argv[1])
 system.initialize()
 t1 = time.perf_counter()
 system.free()

@@ -2,8 +2,10 @@
 quadratic drag at very large steps, each as a linear (or exact nonlinear) theory next to
 in-process co-simulations that use the real kernels.
 
-The in-process runs exchange loads as ``cosim.master`` does (communication step h,
-t_k = k·h, loads held constant over a step, RK4 substeps in the dynamics):
+The runs are scenes built in code, run in-process by the master itself
+(``cosim.inprocess``: the scene's load and dynamics slaves, stepped by ``cosim.master.run``;
+communication step h, t_k = k·h, loads held constant over a step, RK4 substeps in the
+dynamics):
 
 - ``gauss-seidel``: F_k = F(motion at t_k) acts over [t_k, t_k+1];
 - ``jacobi``: F(motion at t_k−1) acts over [t_k, t_k+1]; the first two steps both use
@@ -11,6 +13,8 @@ t_k = k·h, loads held constant over a step, RK4 substeps in the dynamics):
 
 The motion handed to load kernels carries the dynamics' acceleration output, which is
 computed from the state and the load held over the previous step (``RigidBody.acceleration``).
+Growth factors are computed from the run's samples: the state at t_k+1 next to the load
+held over [t_k, t_k+1] (the load FMU's output sampled at t_k), normalised per study.
 
 1. Explicit added mass (a RIFLEX BODY-like point with added mass A on a body of mass M)
 ---------------------------------------------------------------------------------------
@@ -106,16 +110,14 @@ tangent linearisation, gain 2·k·|W|, would halve both limits: it describes sma
 perturbations of a decaying solution, not whether the amplitude grows.)
 """
 import math
+from pathlib import Path
 
 import numpy as np
 from scipy.linalg import expm
 
-from ..physics.coupling import Coupling
-from ..physics.loads import BodyLoads
-from ..physics.lumped import LumpedBody
-from ..physics.rigid_body import RigidBody
-from ..physics.state import Env, Motion
-from ..physics.viscous_drag import ViscousDrag
+from ..cosim import inprocess, master
+from ..description import Effect, HydroCoupling
+from ..scene import Body, Scene
 
 RATIOS = (0.01, 0.1, 0.5, 0.9, 1.1, 2.0, 10.0, 100.0)   # A/M of the map
 STEPS = (1e-4, 1e-3, 1e-2, 0.1, 1.0)                    # communication steps [s]
@@ -124,60 +126,44 @@ BLOWUP = 1e30           # normalised state beyond which a run is declared diverg
 ALGORITHMS = ("gauss-seidel", "jacobi")
 
 
-# -- the co-simulation exchange -------------------------------------------------------
-class _Diverged(Exception):
-    pass
+# -- runs through the master -----------------------------------------------------------
+def _body(name, mass, stiffness=0.0, damping=0.0, velocity=None, mode="export", effects=()):
+    """Scene body of ``mass`` [kg] at the origin with gyration radius 10 m, translational
+    stiffness [N/m] and damping [N·s/m], rotational ones 100× (the same natural period)."""
+    per_dof = lambda x: [x] * 3 + [100.0 * x] * 3
+    return Body(name, [0.0] * 3, [0.0] * 3, list(velocity if velocity is not None else [0.0] * 6), mass,
+                np.diag([100.0 * mass] * 3).tolist(), [0.0] * 3, np.diag(per_dof(stiffness)).tolist(),
+                np.diag(per_dof(damping)).tolist(), mode, list(effects))
 
 
-def _exchange(bodies, loads, dt, n_steps, algorithm, observe):
-    """Run ``n_steps`` steps of ``dt`` [s] with the master's exchange.  ``loads(motions)``
-    -> list of (6,) loads, one per body, from their motions at this communication point;
-    ``observe(k, held)`` after each step (held: the loads applied over that step).
-    Raises _Diverged when a load or state turns non-finite."""
+def _scene(bodies, dt, substep, couplings=(), current=0.0):
+    """A scene of ``bodies``, run settings for step ``dt`` [s], current [m/s] along ±x."""
+    run_cfg = {"preset": None, "step": dt, "stop": dt, "algorithm": "gauss-seidel", "substep": substep,
+               "load_hold": "constant", "memory": {}, "set": []}
+    return Scene("stability", Path("bench/stability"), 1025.0, 9.81, abs(current), 0.0 if current >= 0 else 180.0,
+                 {b.name: b for b in bodies}, run_cfg, couplings=list(couplings))
+
+
+def _growth(scene, n_steps, algorithm, norm, parameters=None):
+    """Growth factor of a scene's run through the master: ``norm(state, held)`` of the
+    samples, max over the last quarter; inf when it leaves BLOWUP or a slave reports a
+    non-finite value.  ``state(instance, name, n)``: outputs at t_1 … t_n;
+    ``held(instance, name, n)``: outputs at t_0 … t_n−1, which for a load FMU is the load
+    held over the step that follows (Gauss–Seidel: F(x_k) sampled after the exchange at t_k;
+    Jacobi: F(x_k−1) sampled before it)."""
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {ALGORITHMS}, not {algorithm!r}")
-    previous = None
-    for k in range(n_steps):
-        now = [np.asarray(f, float) for f in loads([b.motion() for b in bodies])]
-        held = previous if (algorithm == "jacobi" and previous is not None) else now
-        if not all(np.all(np.isfinite(f)) for f in held):
-            raise _Diverged
-        for b, f in zip(bodies, held):
-            b.step(dt, f)
-        previous = now
-        if not all(np.all(np.isfinite(b.state())) for b in bodies):
-            raise _Diverged
-        observe(k, held)
-
-
-def _run_growth(bodies, loads, dt, n_steps, algorithm, norm):
-    """max over the last quarter of ``norm(held)`` (normalised state), inf if it leaves
-    BLOWUP or turns non-finite."""
-    first = n_steps - max(1, n_steps // 4)
-    peak = [0.0]
-
-    def observe(k, held):
-        value = norm(held)
-        if not value < BLOWUP:
-            raise _Diverged
-        if k >= first:
-            peak[0] = max(peak[0], value)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            _exchange(bodies, loads, dt, n_steps, algorithm, observe)
-    except _Diverged:
+            result = master.run(inprocess.system(scene, parameters), stop=n_steps * scene.run["step"],
+                                step=scene.run["step"], algorithm=algorithm, progress=False)
+    except master.RunError:
         return math.inf
-    return peak[0]
-
-
-def _oscillator(mass, stiffness, damping=None, added=None, velocity0=None, max_substep=0.01):
-    """RigidBody of ``mass`` [kg] with gyration radius 10 m, translational stiffness
-    ``stiffness`` [N/m] and rotational stiffness giving the same natural period."""
-    inertia = mass * 100.0 * np.eye(3)
-    k = np.diag([stiffness] * 3 + [100.0 * stiffness] * 3)
-    d = None if damping is None else np.diag([damping] * 3 + [100.0 * damping] * 3)
-    return RigidBody(mass, inertia, stiffness=k, damping=d, added_mass=added,
-                     velocity0=velocity0, max_substep=max_substep)
+    values = norm(lambda i, name, n: result.vector(i, name, n)[1:],
+                  lambda i, name, n: result.vector(i, name, n)[:-1])
+    if not np.all(values < BLOWUP):
+        return math.inf
+    return float(values[n_steps - max(1, n_steps // 4):].max())
 
 
 # -- 1. explicit added mass -------------------------------------------------------------
@@ -206,28 +192,27 @@ def added_mass_theory(ratio, dt, period=20.0, zeta=0.0, mode="explicit"):
 
 
 def added_mass_run(ratio, dt, mode, n_steps=400, period=20.0, zeta=0.0, mass=MASS, v0=1.0):
-    """Growth factor (module docstring, section 1) of an in-process Gauss–Seidel
-    co-simulation: RigidBody (mass M = ``mass`` [kg], heave spring of natural period
-    ``period`` [s] for M alone, damping ratio ``zeta``) + BodyLoads of a LumpedBody at the
-    reference point with AMX = AMY = AMZ = ``ratio``·M (no drag, AM = AE = 0), started
-    with heave velocity ``v0`` [m/s].  ``mode``: 'explicit' (BodyLoads applies −A·a) or
-    'export' (A in the RigidBody's added_mass).  RK4 substeps ≤ min(dt, period/50)."""
+    """Growth factor (module docstring, section 1) of a Gauss–Seidel co-simulation through
+    the master: a body of mass M = ``mass`` [kg] on a heave spring of natural period
+    ``period`` [s] for M alone, damping ratio ``zeta``, carrying a RIFLEX BODY at the
+    reference point with AMX = AMY = AMZ = ``ratio``·M (no drag, AM = AE = 0), started with
+    heave velocity ``v0`` [m/s].  ``mode``: the body's acceleration loads, 'explicit' (the
+    load FMU applies −A·a) or 'export' (A in the dynamics' mass matrix).  RK4 substeps
+    ≤ min(dt, period/50)."""
     if mode not in ("explicit", "export"):
         raise ValueError(f"mode must be 'explicit' or 'export', not {mode!r}")
     a = ratio * mass
-    point = LumpedBody("point", [0.0, 0.0, 0.0], added_mass=[a, a, a])
-    loads = BodyLoads([point], explicit=(mode == "explicit"))
+    point = Effect("riflex_body", "point", {"offset": [0.0] * 3, "am": 0.0, "ae": 0.0, "icoo": "GLOBAL",
+                                            "cd": [0.0] * 3, "added_mass": [a, a, a]})
     k, c = _spring(period, zeta, mass)
-    added = None if loads.explicit else loads.mass_matrix(Motion())
-    body = _oscillator(mass, k, c, added, [0.0, 0.0, v0, 0.0, 0.0, 0.0], min(dt, period / 50.0))
-    env = Env()
+    body = _body("hull", mass, k, c, [0.0, 0.0, v0, 0.0, 0.0, 0.0], mode, [point])
     x_scale = v0 * math.sqrt((mass + a) / k)
 
-    def norm(held):
-        return max(abs(body.position[2]) / x_scale, abs(body.velocity[2]) / v0,
-                   abs(held[0][2]) / (k * x_scale))
-    return _run_growth([body], lambda motions: [loads.effect_loads(motions[0], env).sum(axis=0)],
-                       dt, n_steps, "gauss-seidel", norm)
+    def norm(state, held):
+        return np.maximum.reduce([np.abs(state("hull_dynamics", "position", 3)[:, 2]) / x_scale,
+                                  np.abs(state("hull_dynamics", "velocity", 6)[:, 2]) / v0,
+                                  np.abs(held("hull", "force", 6)[:, 2]) / (k * x_scale)])
+    return _growth(_scene([body], dt, min(dt, period / 50.0)), n_steps, "gauss-seidel", norm)
 
 
 def added_mass_map(ratios=RATIOS, steps=STEPS, n_steps=400, period=20.0, zeta=0.0):
@@ -329,29 +314,31 @@ def cross_body_theory(cross, mass_a=MASS, mass_b=MASS, self_a=None, self_b=None,
 def cross_body_run(cross, mass_a=MASS, mass_b=MASS, self_a=None, self_b=None, dt=0.1, n_steps=400,
                    period=20.0, zeta=0.0, v0=1.0, algorithm="gauss-seidel"):
     """Growth factor of two bodies coupled by the cross added mass ``cross`` = A_AB
-    (6×6, load on A per acceleration of B; B gets A_ABᵀ), applied explicitly through
-    physics.coupling.Coupling.acceleration_load from the neighbour's acceleration output.
-    Each body: RigidBody of mass ``mass_a``/``mass_b`` [kg] (gyration radius 10 m), its own
-    added mass ``self_a``/``self_b`` (6×6) in its mass matrix, springs of natural period
-    ``period`` [s] and damping ratio ``zeta`` for the dry body.  A starts with velocity
-    ``v0`` [m/s] in surge, sway and heave, B at rest.  Growth: max over the last quarter of
-    max(|x|/X, |v|/v0, |F|/(K·X)), X = v0·T/(2π), over both bodies and all translations;
-    inf if it diverged."""
-    coupling = Coupling(cross, name="AB")
+    (6×6, load on A per acceleration of B; B gets A_ABᵀ), a SIMO coupling without kernels
+    applied explicitly by the load FMUs from the neighbour's acceleration output, run
+    through the master.  Each body: mass ``mass_a``/``mass_b`` [kg] (gyration radius
+    10 m), its own added mass ``self_a``/``self_b`` (6×6) in its dynamics' mass matrix (the
+    ``added_mass`` parameters), springs of natural period ``period`` [s] and damping ratio
+    ``zeta`` for the dry body.  A starts with velocity ``v0`` [m/s] in surge, sway and
+    heave, B at rest.  Growth: max over the last quarter of max(|x|/X, |v|/v0, |F|/(K·X)),
+    X = v0·T/(2π), over both bodies and all translations; inf if it diverged."""
     omega = 2.0 * math.pi / period
-    sub = min(dt, period / 50.0)
-    bodies = [_oscillator(m, m * omega ** 2, 2.0 * zeta * m * omega, own, v, sub)
-              for m, own, v in ((mass_a, self_a, [v0] * 3 + [0.0] * 3), (mass_b, self_b, None))]
+    bodies = [_body(n, m, m * omega ** 2, 2.0 * zeta * m * omega, v, "explicit")
+              for n, m, v in (("a", mass_a, [v0] * 3 + [0.0] * 3), ("b", mass_b, None))]
+    coupling = HydroCoupling("AB", "a", "b", np.asarray(cross, float), None, [])
+    parameters = {f"{n}_dynamics.added_mass[{i + 1},{j + 1}]": own[i, j]
+                  for n, own in (("a", self_a), ("b", self_b)) if own is not None
+                  for i in range(6) for j in range(6)}
     x_scale = v0 / omega
 
-    def loads(motions):
-        return [coupling.acceleration_load("A", motions[1].acceleration),
-                coupling.acceleration_load("B", motions[0].acceleration)]
-
-    def norm(held):
-        return max(max(np.abs(b.position).max() / x_scale, np.abs(b.velocity[:3]).max() / v0,
-                       np.abs(f[:3]).max() / (b.stiffness[0, 0] * x_scale)) for b, f in zip(bodies, held))
-    return _run_growth(bodies, loads, dt, n_steps, algorithm, norm)
+    def norm(state, held):
+        return np.maximum.reduce([np.maximum.reduce([
+            np.abs(state(f"{b.name}_dynamics", "position", 3)).max(axis=1) / x_scale,
+            np.abs(state(f"{b.name}_dynamics", "velocity", 6)[:, :3]).max(axis=1) / v0,
+            np.abs(held(b.name, "force", 6)[:, :3]).max(axis=1) / (b.mass * omega ** 2 * x_scale)])
+            for b in bodies])
+    scene = _scene(bodies, dt, min(dt, period / 50.0), [coupling])
+    return _growth(scene, n_steps, algorithm, norm, parameters)
 
 
 # -- 3. quadratic drag -----------------------------------------------------------------
@@ -367,29 +354,26 @@ def drag_step_limit(mass, c, speed, algorithm="gauss-seidel"):
 def drag_run(speed, dt, algorithm="gauss-seidel", mass=MASS, c=1.0e4, current=0.0, added=0.0,
              kernel="aqwa", n_steps=60):
     """Growth factor max|u_c − v|/speed over the last quarter (inf if diverged) of a free
-    body (no spring) in surge under quadratic drag, in-process with the master's exchange.
-    ``kernel``: 'aqwa' (ViscousDrag, V11 = c, RELATIVE when current ≠ 0) or 'riflex'
-    (LumpedBody CDX = c, AMX = ``added`` [kg] exported into the RigidBody's mass matrix).
+    body (no spring) in surge under quadratic drag, run through the master.
+    ``kernel``: 'aqwa' (AQWA viscous drag, V11 = c, RELATIVE when current ≠ 0) or 'riflex'
+    (RIFLEX BODY CDX = c, AMX = ``added`` [kg] exported into the dynamics' mass matrix).
     The current [m/s] flows along +x (negative: along −x); the body starts with
     v0 = current − speed, so the relative velocity starts at +speed [m/s]."""
-    env = Env(current_speed=abs(current), current_direction=0.0 if current >= 0 else 180.0)
     if kernel == "aqwa":
         if added:
             raise ValueError("added mass needs kernel='riflex'")
-        effect = ViscousDrag("drag", np.diag([c, 0, 0, 0, 0, 0]), relative=current != 0.0)
+        effect = Effect("aqwa_viscous_drag", "drag", {"matrix": np.diag([c, 0, 0, 0, 0, 0]).tolist(),
+                                                      "relative": current != 0.0})
     elif kernel == "riflex":
-        effect = LumpedBody("drag", [0.0, 0.0, 0.0], cd=[c, 0.0, 0.0], added_mass=[added, 0.0, 0.0])
+        effect = Effect("riflex_body", "drag", {"offset": [0.0] * 3, "am": 0.0, "ae": 0.0, "icoo": "GLOBAL",
+                                                "cd": [c, 0.0, 0.0], "added_mass": [added, 0.0, 0.0]})
     else:
         raise ValueError(f"kernel must be 'aqwa' or 'riflex', not {kernel!r}")
-    loads = BodyLoads([effect])          # export mode: the added mass goes to the dynamics
-    exported = loads.mass_matrix(Motion())
-    body = RigidBody(mass, mass * 100.0 * np.eye(3), added_mass=exported,
-                     velocity0=[current - speed, 0, 0, 0, 0, 0], max_substep=dt)
+    body = _body("hull", mass, velocity=[current - speed, 0, 0, 0, 0, 0], effects=[effect])   # export mode
 
-    def norm(held):
-        return abs(current - body.velocity[0]) / speed
-    return _run_growth([body], lambda motions: [loads.effect_loads(motions[0], env).sum(axis=0)],
-                       dt, n_steps, algorithm, norm)
+    def norm(state, held):
+        return np.abs(current - state("hull_dynamics", "velocity", 6)[:, 0]) / speed
+    return _growth(_scene([body], dt, dt, current=current), n_steps, algorithm, norm)
 
 
 # -- everything, for `hydrofmu bench` -------------------------------------------------

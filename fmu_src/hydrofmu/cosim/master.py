@@ -218,26 +218,21 @@ class Exchange:
 
 
 class System:
-    """The instances of a built scene and the connections between them."""
+    """Loaded instances ({name: Instance}, stepped in ``manifest['order']``) and the
+    manifest's connections between them; ``parameters`` ({'instance.variable': value})
+    are set in initialization mode.  ``load`` gives the System of a built scene,
+    ``cosim.inprocess.system`` one of a scene's slaves in this process."""
 
-    def __init__(self, folder, parameters=None):
-        self.folder = Path(folder)
-        self.manifest = json.loads((self.folder / "manifest.json").read_text())
-        self.order = self.manifest["order"]
-        self.instances = {}
-        try:
-            for name in self.order:
-                self.instances[name] = Instance(name, self.folder / self.manifest["instances"][name]["fmu"])
-        except Exception:
-            self.free()
-            raise
+    def __init__(self, manifest, instances, parameters=None):
+        self.manifest, self.instances = manifest, instances
+        self.order = manifest["order"]
         self.parameters = parameters or {}
         # links grouped by (source, target): one getReal and one setReal per pair
         links = {}
-        for src, svar, dst, dvar in self.manifest["connections"]:
+        for src, svar, dst, dvar in manifest["connections"]:
             links.setdefault((src, dst), ([], []))
-            links[(src, dst)][0].append(self.instances[src].vr[svar])
-            links[(src, dst)][1].append(self.instances[dst].vr[dvar])
+            links[(src, dst)][0].append(instances[src].vr[svar])
+            links[(src, dst)][1].append(instances[dst].vr[dvar])
         self.links = [(s, d, np.array(a), np.array(b)) for (s, d), (a, b) in links.items()]
 
     def transfer(self, targets=None):
@@ -275,16 +270,33 @@ class System:
         self.instances = {}
 
 
+def load(folder, parameters=None):
+    """The System of a built scene's folder (its manifest.json and FMUs), loaded with fmpy."""
+    folder = Path(folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    instances = {}
+    try:
+        for name in manifest["order"]:
+            instances[name] = Instance(name, folder / manifest["instances"][name]["fmu"])
+    except Exception:
+        for inst in instances.values():
+            inst.free()
+        raise
+    return System(manifest, instances, parameters)
+
+
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
         on_step=None):
-    """Run a built scene; returns a Result.
+    """Run a built scene (its folder), or a loaded ``System`` (initialised here, left loaded
+    for the caller to free; ``parameters`` are then the System's own); returns a Result.
 
     ``record``: 'instance.variable' columns (default: every output of every FMU).
     ``parameters``: {'instance.variable': value} set in initialization mode.
     ``progress``: print a progress line to stderr (default: when more than 2000 steps).
     ``on_step``: called with the step count after each communication step (benchmarks).
     """
-    system = System(folder, parameters)
+    own = not isinstance(folder, System)
+    system = load(folder, parameters) if own else folder
     t = 0.0
     try:
         cfg = system.manifest["run"]
@@ -338,7 +350,8 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     except FMICallException as exc:
         raise RunError(failure(system, exc, t)) from None
     finally:
-        system.free()
+        if own:
+            system.free()
 
 
 _STATUS = {1: "warning", 2: "discard", 3: "error", 4: "fatal"}

@@ -202,6 +202,21 @@ def connections(system, slaves):
     return conns
 
 
+def manifest(scene, system, conns):
+    """What our masters read (manifest.json): instances, routes, run settings, connections."""
+    return {
+        "scene": scene.name, "source": str(scene.path), "run": scene.run,
+        "instances": {i.name: {"fmu": f"{i.model_id}.fmu", "kind": i.kind, "body": i.body}
+                      for i in system.instances},
+        "dynamics": {body: list(v) for body, v in system.dynamics.items()},
+        "stability_indicators": system.indicators,
+        "couplings": {c.name: {"method": c.method, "tolerance": c.tolerance, "order": c.order,
+                               "memory_length": c.memory_length, "set": c.set} for c in scene.couplings},
+        "order": [i.name for i in system.instances],
+        "connections": conns,
+    }
+
+
 def osp_system_structure(scene, system, conns):
     """OspSystemStructure.xml text: libcosim's description of the same system."""
     ns = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
@@ -273,18 +288,7 @@ def _build_into(scene, outdir, target, system, runtime, shim, log):
         conns = connections(system, slaves)
         result = work / "fmus"
         report_bem(scene, log, result)
-        manifest = {
-            "scene": scene.name, "source": str(scene.path), "run": scene.run,
-            "instances": {i.name: {"fmu": f"{i.model_id}.fmu", "kind": i.kind, "body": i.body}
-                          for i in system.instances},
-            "dynamics": {body: list(v) for body, v in system.dynamics.items()},
-            "stability_indicators": system.indicators,
-            "couplings": {c.name: {"method": c.method, "tolerance": c.tolerance, "order": c.order,
-                                   "memory_length": c.memory_length, "set": c.set} for c in scene.couplings},
-            "order": [i.name for i in system.instances],
-            "connections": conns,
-        }
-        (result / "manifest.json").write_text(json.dumps(manifest, indent=2))
+        (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns), indent=2))
         (result / "OspSystemStructure.xml").write_text(osp_system_structure(scene, system, conns))
         write_ssp(result / f"{scene.name}.ssp", scene.name,
                   {i.name: result / f"{i.model_id}.fmu" for i in system.instances}, conns,
