@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..decks.simo import format_coupling, write_couplings
-from ..physics.loads import BodyLoads, make_effect
+from ..assembly import body_loads
 from ..physics.state import Env, Motion
 from .kernels import coupling_kernels, irregular_velocity
 from .timing import per_call
@@ -126,7 +126,7 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
         return step
 
     def kernel_run():
-        loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects])
+        loads = body_loads(body)
         memories = []
         for c in scene.couplings:
             model = c.model(v0_a=va[0], v0_b=vb[0])
