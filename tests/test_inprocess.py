@@ -80,3 +80,4 @@ def test_inprocess_equals_built_fmus(scene_and_build, algorithm):
     assert {"a", "b", "pin", "a_b_dynamics"} <= {c.split(".")[0] for c in fmus.columns}
     assert np.abs(fmus.values).max() > 0 and np.all(np.isfinite(fmus.values))
     np.testing.assert_allclose(local.values, fmus.values, rtol=1e-12, atol=1e-9)
+    assert local.units == fmus.units and fmus.units["a.force[4]"] == "N.m"

@@ -59,6 +59,7 @@ class Local:
         self.name, self.slave, self.fmu = name, slave, Calls(slave)
         self.vr = {v.name: vr for vr, v in slave.vars.items()}
         self.causality = {v.name: v.causality.name for v in slave.vars.values()}
+        self.units = slave.units
         self.feedthrough = any(slave.dependencies.values())
         self.errors = []   # error messages the slave logged (the master puts them in its RunError)
 

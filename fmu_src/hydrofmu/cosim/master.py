@@ -26,7 +26,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
-from .result import Result, column_units
+from .result import Result
 
 
 class RunError(RuntimeError):
@@ -72,6 +72,7 @@ class Instance:
         self.dir = extract(str(fmu_path))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.causality = {v.name: v.causality for v in self.md.modelVariables}
+        self.units = {v.name: v.unit for v in self.md.modelVariables if v.unit}
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
         # Our own logger, given straight to the FMU: fmpy's default goes through a process-
@@ -264,6 +265,15 @@ class System:
         for inst in self.instances.values():
             inst.fmu.exitInitializationMode()
 
+    def units(self, columns):
+        """Column 'instance.variable' -> unit, as the instances declare them."""
+        out = {}
+        for col in columns:
+            name, var = col.split(".", 1)
+            if var in self.instances[name].units:
+                out[col] = self.instances[name].units[var]
+        return out
+
     def free(self):
         for inst in self.instances.values():
             inst.free()
@@ -346,7 +356,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
             sys.stderr.write("\n")
         return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"],
                       run_settings(system.manifest, step, algorithm, stop),
-                      column_units(system.folder, system.manifest, record), system.manifest)
+                      system.units(record), system.manifest)
     except FMICallException as exc:
         raise RunError(failure(system, exc, t)) from None
     finally:
