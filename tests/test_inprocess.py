@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from hydrofmu.cosim import inprocess
-from hydrofmu.cosim.master import run
+from hydrofmu.cosim.master import RunError, run
 from hydrofmu.scene import load_scene
 
 from conftest import build, write_scene
@@ -81,3 +81,16 @@ def test_inprocess_equals_built_fmus(scene_and_build, algorithm):
     assert np.abs(fmus.values).max() > 0 and np.all(np.isfinite(fmus.values))
     np.testing.assert_allclose(local.values, fmus.values, rtol=1e-12, atol=1e-9)
     assert local.units == fmus.units and fmus.units["a.force[4]"] == "N.m"
+
+
+def test_inprocess_fails_as_the_fmus_do(scene_and_build):
+    """A non-finite current input: the same RunError (call, time, the slave's message) in
+    process as through fmpy and the FMUs' shim."""
+    scene, folder = scene_and_build
+    bad = {"a.current.speed": float("nan")}
+    with pytest.raises(RunError) as fmus:
+        run(folder, parameters=bad, progress=False)
+    with pytest.raises(RunError) as local:
+        run(inprocess.system(scene, bad), progress=False)
+    assert "not finite" in str(fmus.value)
+    assert str(local.value) == str(fmus.value)

@@ -31,37 +31,50 @@ class Port:
 
 
 class Calls:
-    """The fmpy FMU2Slave calls the master makes at initialisation, on a slave."""
+    """The fmpy FMU2Slave calls the master makes at initialisation, on a slave; each one
+    fails as through the FMU's shim when the slave logged an error (``Local.check``)."""
 
-    def __init__(self, slave):
-        self.slave = slave
+    def __init__(self, local):
+        self.local, self.slave = local, local.slave
 
     def setupExperiment(self, startTime=0.0):
-        self.slave.setup_experiment(startTime, None, None)
+        self.local.check("fmi2SetupExperiment", self.slave.setup_experiment(startTime, None, None))
 
     def enterInitializationMode(self):
-        self.slave.enter_initialization_mode()
+        self.local.check("fmi2EnterInitializationMode", self.slave.enter_initialization_mode())
 
     def exitInitializationMode(self):
-        self.slave.exit_initialization_mode()
+        self.local.check("fmi2ExitInitializationMode", self.slave.exit_initialization_mode())
 
     def getReal(self, vrs):
-        return self.slave.get_real(np.asarray(vrs, dtype=int))
+        return self.local.check("fmi2GetReal", self.slave.get_real(np.asarray(vrs, dtype=int)))
 
     def setReal(self, vrs, values):
-        self.slave.set_real(np.asarray(vrs, dtype=int), values)
+        self.local.check("fmi2SetReal", self.slave.set_real(np.asarray(vrs, dtype=int), values))
 
 
 class Local:
     """A slave in this process as the master's ``Instance``."""
 
     def __init__(self, name, slave):
-        self.name, self.slave, self.fmu = name, slave, Calls(slave)
+        self.name, self.slave = name, slave
+        self.fmu = Calls(self)
         self.vr = {v.name: vr for vr, v in slave.vars.items()}
         self.causality = {v.name: v.causality.name for v in slave.vars.values()}
         self.units = slave.units
         self.feedthrough = any(slave.dependencies.values())
         self.errors = []   # error messages the slave logged (the master puts them in its RunError)
+
+    def check(self, function, result):
+        """``result``, unless the call logged an error or returned False (fmi2DoStep): then
+        the FMICallException fmpy raises for fmi2Error, the messages kept in ``errors``."""
+        queue = self.slave.log_queue
+        errors = [m.msg for m in queue if m.status in (Fmi2Status.error, Fmi2Status.fatal)]
+        queue.clear()
+        if errors or result is False:
+            self.errors += errors
+            raise FMICallException(function=function, status=3)
+        return result
 
     def outputs(self):
         return [n for n, c in self.causality.items() if c == "output"]
@@ -70,16 +83,13 @@ class Local:
         return Port(vrs)
 
     def read(self, port):
-        port.values[:] = self.slave.get_real(port.vr)
+        port.values[:] = self.check("fmi2GetReal", self.slave.get_real(port.vr))
 
     def write(self, port):
-        self.slave.set_real(port.vr, port.values.copy())
+        self.check("fmi2SetReal", self.slave.set_real(port.vr, port.values.copy()))
 
     def do_step(self, t, h):
-        if not self.slave.do_step(t, h):   # an FMU's fmi2Error, with what the slave logged
-            self.errors += [m.msg for m in self.slave.log_queue if m.status in (Fmi2Status.error, Fmi2Status.fatal)]
-            self.slave.log_queue.clear()
-            raise FMICallException(function="fmi2DoStep", status=3)
+        self.check("fmi2DoStep", self.slave.do_step(t, h))
 
     def free(self):
         pass
