@@ -221,7 +221,7 @@ def _connector(scene, joint, exported, env):
 
 def assemble(scene) -> System:
     """The FMU instances of a validated scene, their typed descriptions and routes."""
-    env = d.Environment(scene.rho, scene.g, scene.current_speed, scene.current_direction)
+    env = d.Environment(scene.rho, scene.g, scene.current_speed, scene.current_direction, scene.current_profile)
     exported = exported_mass(scene)
     dyn_of, groups = dynamics_groups(scene)
     sides = coupling_sides(scene.couplings)

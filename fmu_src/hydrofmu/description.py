@@ -34,6 +34,7 @@ class Environment:
     g: float
     current_speed: float
     current_direction: float
+    current_profile: np.ndarray | None = None   # rows [z m, speed m/s, direction deg]; None: uniform
 
 
 @dataclass

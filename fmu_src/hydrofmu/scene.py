@@ -53,6 +53,7 @@ class Scene:
     run: dict
     joints: dict = field(default_factory=dict)
     couplings: list = field(default_factory=list)
+    current_profile: list = None     # [[z m, speed m/s, direction deg], ...] or None (uniform)
 
 
 class Problems:
@@ -205,13 +206,13 @@ def identifier(name):
 
 # --- effect types: each validator turns the scene table into kernel data ------------
 
-def _deck_path(problems, table, where):
-    deck = problems.string(table, "deck", f"{where}.deck")
+def _deck_path(problems, table, where, key="deck"):
+    deck = problems.string(table, key, f"{where}.{key}")
     if deck is None:
         return None
     path = (problems.path.parent / deck).resolve()
     if not path.is_file():
-        problems.add(f"{where}.deck", f"deck file not found: {path}")
+        problems.add(f"{where}.{key}", f"deck file not found: {path}")
         return None
     return path
 
@@ -643,7 +644,8 @@ def load_scene(path, overrides=None):
     if not isinstance(name, str) or not identifier(name):
         p.add("scene.name", f"scene name must be an identifier, found {name!r}")
     env = p.table(doc, "environment", "environment", required=False) or {}
-    p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction"})
+    p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction", "current_profile",
+                                      "current_deck", "current_format"})
     run = p.table(doc, "run", "run", required=False) or {}
     p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset"})
     preset = run.get("preset")
@@ -683,10 +685,10 @@ def load_scene(path, overrides=None):
     g = p.number(env, "g", "environment.g", 9.81, positive=True)
     couplings = (_couplings(p, doc["couplings"], bodies, run_cfg["memory"], {"rho": rho, "g": g})
                  if "couplings" in doc else [])
+    speed, direction, profile = _current(p, env)
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
-        current_speed=p.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),
-        current_direction=p.number(env, "current_direction", "environment.current_direction", 0.0),
+        current_speed=speed, current_direction=direction, current_profile=profile,
         bodies=bodies, run=run_cfg,
     )
     p.raise_if_any()
@@ -694,6 +696,72 @@ def load_scene(path, overrides=None):
 
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
+CURRENT_FORMATS = ("deeplines", "sima")
+
+
+def _current(problems, env):
+    """(surface speed, surface direction, profile rows or None) of ``[environment]``: a uniform
+    current (current_speed, current_direction), an inline ``current_profile`` of
+    [z, speed, direction] rows, or a ``current_deck`` read by its ``current_format``."""
+    from .physics.current import CurrentProfile, profile_problem
+    given = [k for k in ("current_profile", "current_deck") if k in env]
+    uniform = [k for k in ("current_speed", "current_direction") if k in env]
+    if len(given) > 1 or (given and uniform):
+        problems.add(f"environment.{(given + uniform)[1]}", f"give the current once: current_speed/current_direction "
+                                                            f"(uniform), current_profile or current_deck")
+        return None, None, None
+    if not given:
+        return (problems.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),
+                problems.number(env, "current_direction", "environment.current_direction", 0.0), None)
+    if "current_deck" in env:
+        rows = _current_deck(problems, env)
+    else:
+        rows = _profile_rows(problems, env["current_profile"], "environment.current_profile")
+        if rows is not None:
+            problem = profile_problem(*zip(*rows))
+            if problem is not None:
+                k, name, message = problem
+                problems.add(f"environment.current_profile[{k}]", f"{name}: {message}")
+                rows = None
+    if rows is None:
+        return None, None, None
+    profile = CurrentProfile.from_rows(rows)
+    return profile.surface_speed, profile.surface_direction, [list(r) for r in rows]
+
+
+def _profile_rows(problems, raw, where):
+    """[[z, speed, direction], ...] from the scene, or None after recording one problem."""
+    if not isinstance(raw, list) or not raw:
+        problems.add(where, "expected rows [z, speed, direction] (z m up from the mean free surface, "
+                            "speed m/s, direction deg going to)")
+        return None
+    for k, row in enumerate(raw):
+        if not isinstance(row, list) or len(row) != 3:
+            n = len(row) if isinstance(row, list) else 1
+            problems.add(f"{where}[{k}]", f"{'missing value' if n < 3 else 'too many values'}: expected "
+                                          f"[z, speed, direction], found {row!r}")
+            return None
+        for name, v in zip(("z", "speed", "direction"), row):
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                problems.add(f"{where}[{k}]", f"{name}: expected a number, found {v!r}")
+                return None
+    return [[float(v) for v in row] for row in raw]
+
+
+def _current_deck(problems, env):
+    """Profile rows from a vendor file: DeepLines *CURRENT/*CURPROF or a SIMA (SIMO/RIFLEX)
+    current profile file; deck errors are recorded with their file, line and field."""
+    from .decks.deeplines import read_current_profile
+    from .decks.simo import read_current_profile as read_sima
+    fmt = problems.choice(env, "current_format", "environment.current_format", CURRENT_FORMATS)
+    path = _deck_path(problems, env, "environment", "current_deck")
+    if fmt is None or path is None:
+        return None
+    try:
+        return (read_current_profile if fmt == "deeplines" else read_sima)(path)
+    except InputError as exc:
+        problems.add("environment.current_deck", str(exc))
+        return None
 
 
 def override(doc, key, value, path="scene"):

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .lines import fields, read_lines
+from .lines import check_profile, fields, read_lines
 
 KEYWORD = "*CURRENTPOL"
 ROW = ("ANGC", "CXC", "CYC", "CMZC")
@@ -145,3 +145,54 @@ def _name(head):
         raise head.error("NAME", f"structure name must have at most 8 characters, found {name!r} ({len(name)})")
     return name
 
+
+# --- current profile: *CURRENT and *CURPROF ---------------------------------------------
+CURRENT, CURPROF = "*CURRENT", "*CURPROF"
+
+
+def read_current_profile(path):
+    """The current of a DeepLines data file as profile rows [[z, speed, direction], ...].
+
+    hydrofmu's reading of the two keywords (the manual excerpt names them, not their data)::
+
+        *CURRENT
+          VC  DIRC               surface speed [m/s], direction [deg, going to, CCW from +x]
+        *CURPROF                 (optional: without it the current is uniform)
+          Z  RATIO  [DIR]        one row per level: z ≤ 0 [m] (z up, 0 at the mean free surface),
+                                 speed RATIO·VC, direction DIR (default DIRC)
+
+    Other keywords are skipped.  Raises InputError naming file, line and field.
+    """
+    lines = read_lines(path, comment=("!", "#"))
+    blocks = {}
+    pos = 0
+    while pos < len(lines):
+        end = pos + 1
+        while end < len(lines) and not lines[end].text.startswith("*"):
+            end += 1
+        key = lines[pos].text.replace(" ", "").upper().split(",")[0]
+        if key in (CURRENT, CURPROF):
+            if key in blocks:
+                raise lines[pos].error(key, f"{key} given twice (first at line {blocks[key][0].number})")
+            blocks[key] = (lines[pos], lines[pos + 1:end])
+        pos = end
+    if CURRENT not in blocks:
+        raise InputError(path, None, CURRENT, "no *CURRENT keyword in the file")
+    head, body = blocks[CURRENT]
+    if len(body) != 1:
+        at = body[1] if len(body) > 1 else head
+        raise at.error("VC", f"*CURRENT takes one line 'VC DIRC', found {len(body)}")
+    c = fields(body[0], ["VC", "DIRC"])
+    if CURPROF not in blocks:
+        rows, where = [[0.0, c["VC"], c["DIRC"]]], [(body[0], {"z": "VC", "speed": "VC", "direction": "DIRC"})]
+    else:
+        head, body = blocks[CURPROF]
+        if not body:
+            raise head.error("Z", "*CURPROF has no 'Z RATIO [DIR]' row")
+        rows, where = [], []
+        for k, line in enumerate(body):
+            names = [f"Z({k + 1})", f"RATIO({k + 1})", f"DIR({k + 1})"]
+            v = fields(line, names, defaults={names[2]: c["DIRC"]})
+            rows.append([v[names[0]], v[names[1]] * c["VC"], v[names[2]]])
+            where.append((line, dict(zip(("z", "speed", "direction"), names))))
+    return check_profile(rows, where)

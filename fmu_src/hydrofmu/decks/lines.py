@@ -206,3 +206,16 @@ class Cursor:
         line = self.lines[self.pos]
         self.pos += 1
         return line
+
+
+def check_profile(rows, where):
+    """Check current profile rows [[z, speed, direction], ...] read from a file
+    (physics.current.profile_problem); ``where[k]`` = (line, {"z": field, "speed": field,
+    "direction": field}) names the first problem's line and field."""
+    from ..physics.current import profile_problem
+    problem = profile_problem(*zip(*rows))
+    if problem is not None:
+        k, name, message = problem
+        line, names = where[k]
+        raise line.error(names[name], message)
+    return rows

@@ -51,7 +51,7 @@ import numpy as np
 from ..admissible import symmetric
 from ..errors import InputError
 from . import units as unit_systems
-from .lines import DEFAULT, Cursor, convert, fields, fread_lines, is_end, is_keyword, keyword_key
+from .lines import DEFAULT, Cursor, check_profile, convert, fields, fread_lines, is_end, is_keyword, keyword_key
 
 GROUP = "HYDRodynamic COUPling DATA"
 BODY = "BODY DATA"
@@ -291,3 +291,33 @@ def write_couplings(path, groups, header="SIMO hydrodynamic coupling data (SI un
         text += ["'"] + list(g)
     Path(path).write_text("\n".join(text) + "\n")
     return Path(path)
+
+
+def read_current_profile(path):
+    """A SIMA current profile file (SIMO's and RIFLEX's "regular current from file") as
+    profile rows [[z, speed, direction], ...].  Layout (FREAD rules)::
+
+        NCUR                        number of levels
+        CURLEV CURDIR CURVEL        NCUR lines: global z [m] (z up, 0 at the mean free surface),
+                                    direction [deg, going to, CCW from +x], speed [m/s]
+
+    Raises InputError naming file, line and field (a missing or extra level, a missing value,
+    a level above the surface, levels not ordered)."""
+    cur = Cursor(fread_lines(path), path)
+    head = cur.next("NCUR")
+    n = fields(head, ["NCUR"], int)["NCUR"]
+    if n < 1:
+        raise head.error("NCUR", f"must be ≥ 1, found {n}")
+    rows, where = [], []
+    for k in range(n):
+        names = [f"CURLEV({k + 1})", f"CURDIR({k + 1})", f"CURVEL({k + 1})"]
+        line = cur.next(names[0])
+        if is_end(line):
+            raise line.error(names[0], f"NCUR = {n} but only {k} levels given")
+        v = fields(line, names)
+        rows.append([v[names[0]], v[names[2]], v[names[1]]])
+        where.append((line, dict(zip(("z", "direction", "speed"), names))))
+    extra = cur.peek()
+    if extra is not None and not is_end(extra):
+        raise extra.error(f"CURLEV({n + 1})", f"NCUR = {n} but more levels follow")
+    return check_profile(rows, where)

@@ -36,6 +36,7 @@ from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
 from ..physics.rigid_body import CoupledBodies, RigidBody
+from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
@@ -129,11 +130,19 @@ class ArraySlave(Fmi2Slave):
         """current.speed/direction inputs (if used) and rho, g parameters."""
         env = self.config.environment
         self.current = None
+        self.profile = None if env.current_profile is None else CurrentProfile.from_rows(env.current_profile)
         if uses_current:
             self.current = slice(len(self._start), len(self._start) + 2)
-            self.add("current.speed", Fmi2Causality.input, "m/s", env.current_speed, "uniform current speed")
-            self.add("current.direction", Fmi2Causality.input, "deg", env.current_direction,
-                     "current 'going to' direction, counter-clockwise from global +x")
+            if self.profile is None:
+                self.add("current.speed", Fmi2Causality.input, "m/s", env.current_speed, "uniform current speed")
+                self.add("current.direction", Fmi2Causality.input, "deg", env.current_direction,
+                         "current 'going to' direction, counter-clockwise from global +x")
+            else:
+                self.add("current.speed", Fmi2Causality.input, "m/s", env.current_speed,
+                         "current speed at the surface; scales every level of the profile")
+                self.add("current.direction", Fmi2Causality.input, "deg", env.current_direction,
+                         "current 'going to' direction at the surface, counter-clockwise from global +x; "
+                         "turns every level of the profile")
         self.rho = self.add("rho", Fmi2Causality.parameter, "kg/m3", env.rho, "water density")
         self.g = self.add("g", Fmi2Causality.parameter, "m/s2", env.g, "acceleration of gravity")
         return [self.current] if self.current else []
@@ -162,7 +171,7 @@ class ArraySlave(Fmi2Slave):
         key = self.values[[self.rho, self.g]].tolist() + (self.values[self.current].tolist() if self.current
                                                           else [0.0, 0.0])
         if key != getattr(self, "_env_key", None):
-            self._env_key, self._env = key, Env(*key)
+            self._env_key, self._env = key, Env(*key, self.profile)
         return self._env
 
     def finish_registration(self):

@@ -3,7 +3,8 @@
 Load (all in body axes unless said otherwise):
 
     P = (XC, YC, ZC)                        load point [m], body axes; r = R·P (global offset)
-    v_rel = u_c − (v + ω × r)               relative water velocity at P [m/s], global
+    v_rel = u_c − (v + ω × r)               relative water velocity at P [m/s], global; u_c is
+                                            the current at P's height (physics/current.py)
     (vx, vy, ·) = Rᵀ·v_rel                  body axes; the body-z component is ignored
     V = √(vx² + vy²),  α = atan2(vy, vx)    α in degrees in [0, 360), counter-clockwise from
                                             body +x: the direction the water goes to (α = 0 if V = 0)
@@ -201,7 +202,7 @@ class CurrentPolar:
         px, py, pz = self.xc, self.yc, self.zc
         rx, ry, rz = r00 * px + r01 * py + r02 * pz, r10 * px + r11 * py + r12 * pz, r20 * px + r21 * py + r22 * pz
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
-        cx, cy, cz = env.current.tolist()
+        cx, cy, cz = env.current_at(float(motion.position[2]) + rz).tolist()   # current at P
         ux, uy, uz = cx - (vx + wy * rz - wz * ry), cy - (vy + wz * rx - wx * rz), cz - (vz + wx * ry - wy * rx)
         bx, by = r00 * ux + r10 * uy + r20 * uz, r01 * ux + r11 * uy + r21 * uz   # body axes
         v2 = bx * bx + by * by

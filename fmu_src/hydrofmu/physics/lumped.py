@@ -9,7 +9,8 @@ Static and drag loads (``LumpedBody.load``)::
     weight      F = −AM·g·e_z                       (AM [kg])
     buoyancy    F = +ρ·g·AE·e_z                     (AE [m³]; applied whatever the depth)
     drag        F_i = CD_i·vrel_i·|vrel_i|          (CD [N/(m/s)²], per axis)
-                vrel = u_current − (v + ω × R·r)    (water past the point, global)
+                vrel = u_current − (v + ω × R·r)    (water past the point, global; the current
+                                                     at the point's height, physics/current.py)
 
 ICOO=GLOBAL: the drag axes i are the global axes.  ICOO=LOCAL: they are the body's axes
 (vrel is rotated into body axes, the force computed there and rotated back).  In the
@@ -88,7 +89,7 @@ class LumpedBody:
         """Weight, buoyancy and drag on the body [N, N·m], global, about the reference point."""
         rot = motion.rot
         r = rot @ self.offset
-        vrel = env.current - point_velocity(motion.velocity, r)
+        vrel = env.current_at(motion.position[2] + r[2]) - point_velocity(motion.velocity, r)   # at the point
         q = self._axes(rot)
         force = q @ (self.cd * quad(q.T @ vrel))
         force = force + (env.rho * env.g * self.ae - self.am * env.g) * E_Z

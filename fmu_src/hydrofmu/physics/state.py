@@ -3,7 +3,7 @@
 Load kernels ("effects") follow one protocol so the FMU wrapper can hold any mix:
 
     name: str                 # effect name, used for the `<name>.force` output
-    uses_current: bool        # needs Env.current
+    uses_current: bool        # needs the current (Env.current_at its point's height)
     uses_acceleration: bool   # has acceleration loads (mass, added mass)
     load(motion, env) -> (6,) # [force N; moment N·m about the reference point], global
                               # axes, WITHOUT the acceleration loads
@@ -41,14 +41,24 @@ class Motion:
 
 @dataclass
 class Env:
-    """Water density ρ [kg/m³], gravity g [m/s²], uniform current: speed [m/s] and
-    'going to' direction [deg, counter-clockwise from global +x]."""
+    """Water density ρ [kg/m³], gravity g [m/s²], current: speed [m/s] and 'going to'
+    direction [deg, counter-clockwise from global +x] at the surface, and ``profile`` (a
+    physics.current.CurrentProfile, or None: uniform over depth) giving its shape with depth."""
     rho: float = 1025.0
     g: float = 9.81
     current_speed: float = 0.0
     current_direction: float = 0.0
+    profile: object = None
 
     @property
     def current(self):
-        """Global current velocity vector [m/s]."""
+        """Global current velocity vector [m/s] at the surface (everywhere if uniform)."""
         return current_velocity(self.current_speed, self.current_direction)
+
+    def current_at(self, z):
+        """Global current velocity [m/s] at height ``z`` [m] (global, z up, 0 at the mean free
+        surface): U·ratio(z) going to β + turn(z) (physics/current.py)."""
+        if self.profile is None:
+            return self.current
+        ratio, turn = self.profile.shape(z)
+        return current_velocity(self.current_speed * ratio, self.current_direction + turn)

@@ -1,7 +1,8 @@
 """AQWA-style viscous drag: a 6×6 quadratic damping matrix in body axes.
 
     w = [Rᵀ·v ; Rᵀ·ω]                    body velocity of the reference point [m/s, rad/s], body axes
-    RELATIVE:  w[0:3] = Rᵀ·(v − u_c)     the current velocity u_c (global, uniform) is subtracted
+    RELATIVE:  w[0:3] = Rᵀ·(v − u_c)     the current velocity u_c (global) at the reference point's
+                                         height is subtracted (the matrix acts there)
     F_body = −V · (w ∘ |w|)              [N; N·m], body axes, moments about the reference point
     F = [R·F_body[0:3] ; R·F_body[3:6]]  global axes
 
@@ -43,7 +44,7 @@ class ViscousDrag:
         rot = motion.rot
         w = to_body(motion.velocity, rot)
         if self.relative:
-            w[:3] -= rot.T @ env.current
+            w[:3] -= rot.T @ env.current_at(motion.position[2])   # current at the reference point
         return to_global(-(self.matrix @ quad(w)), rot)
 
     def mass_matrix(self, motion):
