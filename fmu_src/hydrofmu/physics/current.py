@@ -4,8 +4,8 @@ give it, and how the FMU inputs ``current.speed`` and ``current.direction`` driv
 Levels z_k [m] (global z up, 0 at the mean free surface, all z_k ≤ 0), speeds U_k ≥ 0 [m/s],
 directions β_k [deg, "going to", counter-clockwise from global +x].  Between two levels the
 speed and the direction are linear in z (the direction along the shorter arc: 350° and 10°
-turn through 0°, not through 180°; exactly 180° apart turns clockwise); above the top level and below the deepest the values
-of that level hold.
+turn through 0°, not through 180°; exactly 180° apart turns clockwise); above the top level
+and below the deepest the values of that level hold.
 
 The profile is stored as a shape about its surface value (z = 0), U_s = U(0), β_s = β(0):
 
