@@ -64,6 +64,30 @@ def test_capytaine_dataset_read_as_written():
     assert np.all(np.isfinite(d.omega)) and d.omega.size == 100
 
 
+def test_single_body_dataset(tmp_path):
+    """A one-body dataset (dofs "Surge" … without a body prefix, as Capytaine writes it): the
+    body takes the dataset's body name and gives one self coupling."""
+    ds = xr.load_dataset(CYL)
+    one = [f"cyl1__{d}" for d in DOFS]
+    ds = ds.sel(influenced_dof=one, radiating_dof=one, body="cyl1")
+    ds = ds.assign_coords(influenced_dof=list(DOFS), radiating_dof=list(DOFS))
+    path = tmp_path / "one.nc"
+    ds.to_netcdf(path)
+    d = read_capytaine(path)
+    assert d.bodies == ["cyl1"] and d.dofs == [("cyl1", k) for k in range(1, 7)]
+    assert d.rotation_centers == {"cyl1": [0.0, -4.0, 0.0]}
+    scene = load_scene(write_scene(tmp_path, bodies_text() + f"""
+        [[couplings]]
+        bem = "{path}"
+        bodies = {{ cyl1 = "a" }}
+        dofs = ["Surge", "Heave", "Pitch"]
+        kernel_length = 20.0
+        """))
+    (c,) = scene.couplings
+    assert (c.name, c.a, c.b) == ("bem_a", "a", "a")
+    assert {(k.dof_a, k.dof_b) for k in c.kernels} == {(1, 1), (1, 5), (3, 3), (5, 1), (5, 5)}
+
+
 def test_wamit_file_read_back_exactly(tmp_path):
     """A .1 file written here from known dimensional values (two bodies, ULEN = 2.5 m,
     ρ = 1025): Ā = A/(ρ·L^k), B̄ = B/(ρ·L^k·ω), k = 3/4/5; PER = −1 and PER = 0 rows."""
