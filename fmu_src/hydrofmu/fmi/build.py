@@ -52,7 +52,7 @@ def runtime_files():
     while todo:
         f = todo.pop()
         rel = f.relative_to(PACKAGE)
-        if rel in seen:
+        if rel in seen or rel == Path("__init__.py"):   # the runtime has an __init__ of its own
             continue
         seen.add(rel)
         here = list(rel.parent.parts)
@@ -70,7 +70,6 @@ def runtime_files():
                 found = _module_file(target)
                 if found is not None:
                     todo.append(found)
-    seen.discard(Path("__init__.py"))   # the runtime has an __init__ of its own
     return sorted(seen)
 
 
