@@ -330,6 +330,24 @@ def test_two_threads_two_instances(hosts, load_fmu):
     assert got[0, steps, outputs[0]] != got[1, steps, outputs[0]]  # the instances differ
 
 
+def test_two_fmus_start_python_at_once(hosts, load_fmu, tmp_path):
+    """Two copies of the FMU (two libraries, two shims) instantiated at the same moment
+    from four threads: one of them starts Python, the other waits for it and uses it
+    (unguarded, the two started Python together and the host crashed)."""
+    vr = load_fmu[3]
+    copy = tmp_path / "copy"
+    shutil.copytree(load_fmu[0], copy)
+    both = (Path(f"{load_fmu[0]},{copy}"),) + load_fmu[1:]
+    inputs, outputs = {vr["velocity[1]"]: 0.3}, [vr["force[1]"]]
+    want = {k: fmpy_reference(load_fmu, 3, 0.1, {v: x * (k + 1) for v, x in inputs.items()}, outputs)
+            for k in range(4)}
+    for _ in range(3):  # a race: a few tries
+        run, got = run_fmi_host(hosts, both, 4, 3, 0.1, inputs, outputs)
+        assert run.returncode == 0 and "host exits normally" in run.stdout, run.stdout + run.stderr
+        assert "LOG" not in run.stdout
+        assert got == {(k, n, o): v for k, ref in want.items() for (n, o), v in ref.items()}
+
+
 def test_python_without_numpy_fails_instantiate_not_the_host(hosts, load_fmu, tmp_path):
     """HYDROFMU_PYTHON names a bare venv (no numpy): fmi2Instantiate returns NULL with
     one log message saying what was tried and how to fix it; the host exits normally."""

@@ -4,8 +4,9 @@
  *
  *   fmi_host DIR ID GUID THREADS STEPS DT INPUTS OUTPUTS
  *
- * DIR is an unzipped FMU, ID its model identifier.  THREADS instances run at once,
- * instance k in its own thread; every step it sets INPUTS ("vr:value,vr:value", values
+ * DIR is an unzipped FMU, ID its model identifier; DIR may list copies of the FMU
+ * ("a,b"), each loaded as a library of its own, instance k using copy k mod n.
+ * THREADS instances run at once, instance k in its own thread; every step it sets INPUTS ("vr:value,vr:value", values
  * times k+1) then steps DT seconds and prints "k step vr value" for every vr of OUTPUTS
  * ("vr,vr").  Log messages are printed as "LOG status category: message" (a NULL
  * category as "NULL-CATEGORY").  A failed fmi2Instantiate prints "instantiate: NULL" and
@@ -27,7 +28,7 @@ typedef struct {
     void *componentEnvironment;
 } Callbacks;
 
-static struct {
+typedef struct {
     C (*Instantiate)(const char *, int, const char *, const char *, const Callbacks *, int, int);
     int (*SetupExperiment)(C, int, double, double, int, double);
     int (*EnterInitializationMode)(C), (*ExitInitializationMode)(C), (*Terminate)(C);
@@ -35,9 +36,11 @@ static struct {
     int (*SetReal)(C, const unsigned *, size_t, const double *);
     int (*GetReal)(C, const unsigned *, size_t, double *);
     int (*DoStep)(C, double, double, int);
-} fmi;
+} Fmi;
 
-static const char *dir, *id, *guid;
+static Fmi fmis[16];
+static const char *dirs[16], *id, *guid;
+static int ndirs;
 static int steps, nin, nout;
 static double dt, in_val[64];
 static unsigned in_vr[64], out_vr[64];
@@ -59,8 +62,9 @@ static void logger(void *env, const char *name, int status, const char *cat, con
 
 static void *run(void *arg) {
     long k = (long)arg;
+    const Fmi fmi = fmis[k % ndirs];
     char uri[4200], name[32];
-    snprintf(uri, sizeof uri, "file://%s/resources", dir);
+    snprintf(uri, sizeof uri, "file://%s/resources", dirs[k % ndirs]);
     snprintf(name, sizeof name, "instance%ld", k);
     Callbacks cb = {logger, calloc, free, NULL, NULL};
     C c = fmi.Instantiate(name, 1 /* co-simulation */, guid, uri, &cb, 0, 0);
@@ -89,33 +93,36 @@ int main(int argc, char **argv) {
         fprintf(stderr, "usage: %s DIR ID GUID THREADS STEPS DT INPUTS OUTPUTS\n", argv[0]);
         return 2;
     }
-    dir = argv[1], id = argv[2], guid = argv[3];
+    id = argv[2], guid = argv[3];
+    for (char *p = strtok(argv[1], ","); p && ndirs < 16; p = strtok(NULL, ",")) dirs[ndirs++] = p;
     int threads = atoi(argv[4]);
     steps = atoi(argv[5]), dt = atof(argv[6]);
     for (char *p = strtok(argv[7], ","); p && nin < 64; p = strtok(NULL, ","), nin++)
         sscanf(p, "%u:%lf", &in_vr[nin], &in_val[nin]);
     for (char *p = strtok(argv[8], ","); p && nout < 64; p = strtok(NULL, ","), nout++)
         sscanf(p, "%u", &out_vr[nout]);
-    char lib[4200];
-    snprintf(lib, sizeof lib, "%s/binaries/linux64/%s.so", dir, id);
-    void *h = dlopen(lib, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        printf("dlopen failed: %s\n", dlerror());
-        return 1;
-    }
     const char *names[] = {"fmi2Instantiate", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
                            "fmi2ExitInitializationMode", "fmi2Terminate", "fmi2FreeInstance",
                            "fmi2SetReal", "fmi2GetReal", "fmi2DoStep"};
-    void **slots = (void **)&fmi; /* members are pointers in the order of names */
-    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
-        if (!(slots[i] = dlsym(h, names[i]))) {
-            printf("missing %s\n", names[i]);
+    void *handles[16];
+    for (int d = 0; d < ndirs; d++) {
+        char lib[4200];
+        snprintf(lib, sizeof lib, "%s/binaries/linux64/%s.so", dirs[d], id);
+        if (!(handles[d] = dlopen(lib, RTLD_NOW | RTLD_LOCAL))) {
+            printf("dlopen failed: %s\n", dlerror());
             return 1;
         }
+        void **slots = (void **)&fmis[d]; /* members are pointers in the order of names */
+        for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+            if (!(slots[i] = dlsym(handles[d], names[i]))) {
+                printf("missing %s\n", names[i]);
+                return 1;
+            }
+    }
     pthread_t t[16];
     for (long k = 0; k < threads && k < 16; k++) pthread_create(&t[k], NULL, run, (void *)k);
     for (long k = 0; k < threads && k < 16; k++) pthread_join(t[k], NULL);
-    dlclose(h);
+    for (int d = 0; d < ndirs; d++) dlclose(handles[d]);
     printf("host exits normally\n");
     return 0;
 }

@@ -38,8 +38,11 @@
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -273,12 +276,30 @@ static int asked_interpreter(Interpreter *py, const char *exe) {
 }
 
 /* Load, initialise and check the interpreter; on return the GIL is released. */
+static int start_interpreter(const Interpreter *pyp);
+
+/*
+ * Several FMUs (each its own copy of the shim, with its own statics) may start Python at
+ * once from a host's threads.  They serialise on an flock of the libpython file: locks of
+ * separate open() calls exclude each other, also within one process.  The one that gets
+ * the lock first starts Python; the others then find it initialised.
+ */
 static int start_python(const char *self) {
     Interpreter py;
     memset(&py, 0, sizeof py);
     const char *env = getenv("HYDROFMU_PYTHON");
     if (env && *env ? !asked_interpreter(&py, env) : !recorded_interpreter(&py, self)) return 0;
-    /* a libpython already loaded but not initialised serves as it is */
+    int lock = open(py.lib, O_RDONLY | O_CLOEXEC); /* a bare soname: no file to lock, no lock */
+    if (lock >= 0)
+        while (flock(lock, LOCK_EX) != 0 && errno == EINTR) {}
+    int ok = start_interpreter(&py);
+    if (lock >= 0) close(lock); /* releases the lock */
+    return ok;
+}
+
+static int start_interpreter(const Interpreter *pyp) {
+    const Interpreter py = *pyp;
+    /* a libpython already loaded (and maybe initialised by another FMU) serves as it is */
     int loaded = dlsym(RTLD_DEFAULT, "Py_IsInitialized") != NULL;
     void *h = loaded ? RTLD_DEFAULT : dlopen(py.lib, RTLD_NOW | RTLD_GLOBAL);
     if (!loaded && !h) {
