@@ -17,10 +17,9 @@ import pandas as pd
 import pytest
 from distributed import Client, LocalCluster
 
-from hydrofmu.batch import load_cases, run_batch
-from hydrofmu.cosim.master import run
+import hydrofmu
+from hydrofmu.batch import load_cases
 from hydrofmu.errors import InputError
-from hydrofmu.fmi.build import build_scene
 from hydrofmu.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,7 +55,7 @@ def test_batch_equals_single_runs(client, tmp_path):
 "environment.current_speed" = 0.8
 """)
     # through the scheduler's address, as `--scheduler ADDRESS` does
-    table = run_batch(cases, tmp_path / "out", scheduler=client.scheduler.address, progress=False)
+    table = hydrofmu.run_batch(cases, tmp_path / "out", scheduler=client.scheduler.address, progress=False)
     assert len(table) == 5 and (table["status"] == "ok").all(), table[["status", "error"]]
     # the workers ran the FMUs they were sent, unpacked in their own folders, not the build's
     shipped = client.run(lambda dask_worker: sorted(
@@ -68,9 +67,9 @@ def test_batch_equals_single_runs(client, tmp_path):
     for _, row in table.iterrows():
         knobs = {k: row[k] for k in ("environment.current_speed", "environment.current_direction", "run.substep")
                  if pd.notna(row[k])}
-        ref_dir = tmp_path / "ref" / row["case"]
-        folder = build_scene(load_scene(SCENE, {**knobs, "run.stop": 10.0}), ref_dir, log=lambda *_: None)
-        ref = run(folder, record=OUTPUTS, progress=False)
+        # the single-run API on the scene rebuilt with the case's values written into it
+        ref = hydrofmu.run(load_scene(SCENE, {**knobs, "run.stop": 10.0}), out=tmp_path / "ref" / row["case"],
+                           record=OUTPUTS, log=lambda *_: None)
         for j, name in enumerate(OUTPUTS):
             x = ref.values[:, j]
             want = {"max": x.max(), "min": x.min(), "mean": x.mean(), "std": x.std(), "final": x[-1]}
@@ -97,7 +96,7 @@ def test_failing_cases_are_reported_and_the_others_finish(client, tmp_path):
 [[cases]]                      # bad input, refused by the scene's own check
 "environment.current_speed" = -1.0
 """)
-    table = run_batch(cases, tmp_path / "out", client=client, progress=False, series=True)
+    table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False, series=True)
     assert list(table["status"]) == ["ok", "ok", "failed", "failed", "failed"]
     assert table["error"].iloc[:2].isna().all() and table["error"].iloc[2:].str.len().min() > 0
     assert "environment.current_speed" in table["error"].iloc[4]
@@ -126,7 +125,7 @@ def test_killed_batch_reruns_only_missing_cases(client, tmp_path):
     before = {p.name: p.read_text() for p in out.glob("cases/*.json")}
     assert 3 <= len(before) < len(directions), "the batch was not killed half-way"
     logs = []
-    table = run_batch(cases, out, client=client, progress=False, log=logs.append)
+    table = hydrofmu.run_batch(cases, out, client=client, progress=False, log=logs.append)
     assert (table["status"] == "ok").all() and len(table) == len(directions)
     assert not any(line.startswith("building") for line in logs)   # the killed run's build is reused
     after = {p.name: json.loads(p.read_text()) for p in out.glob("cases/*.json")}
@@ -136,7 +135,7 @@ def test_killed_batch_reruns_only_missing_cases(client, tmp_path):
     assert {r["batch"] for r in fresh}.isdisjoint(json.loads(t)["batch"] for t in before.values())
     # a third run has nothing left to do
     logs.clear()
-    again = run_batch(cases, out, client=client, progress=False, log=logs.append)
+    again = hydrofmu.run_batch(cases, out, client=client, progress=False, log=logs.append)
     assert {p.name: json.loads(p.read_text()) for p in out.glob("cases/*.json")} == after
     pd.testing.assert_frame_equal(again, table)
 
@@ -162,13 +161,13 @@ def test_lost_worker_is_recorded_and_rerun(client, tmp_path):
     cases = case_file(tmp_path, '[matrix]\n"barge.g" = [9.81, 9.0001, 9.80]\n', stop=5.0)
     client.run(exec, KILLER, {})
     try:
-        table = run_batch(cases, tmp_path / "out", client=client, progress=False)
+        table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
     finally:
         client.run(exec, HEAL, {})
     assert list(table["status"]) == ["ok", "lost", "ok"]
     assert "KilledWorker" in table["error"].iloc[1]
     client.wait_for_workers(2, timeout=60)   # the nanny restarts the dead worker
-    again = run_batch(cases, tmp_path / "out", client=client, progress=False)
+    again = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
     assert (again["status"] == "ok").all() and list(again["case"]) == list(table["case"])
     assert again["barge_dynamics.position[1].max"].iloc[1] > 0
 
@@ -189,5 +188,5 @@ def test_case_file_errors(tmp_path):
     # a name every case shares is checked on the first case, before any case runs
     path = case_file(tmp_path, '[matrix]\n"barge.no_such_parameter" = [1.0]\n')
     with pytest.raises(InputError, match="barge.no_such_parameter"):
-        run_batch(path, tmp_path / "out", progress=False)
+        hydrofmu.run_batch(path, tmp_path / "out", progress=False)
     assert not (tmp_path / "out" / "cases").exists()

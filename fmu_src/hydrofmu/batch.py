@@ -409,7 +409,11 @@ def _open_client(client, scheduler, workers):
     if client is not None:
         return client, []
     if scheduler:
-        c = Client(scheduler)
+        try:
+            c = Client(scheduler, timeout=30)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError("command line", None, "--scheduler",
+                             f"no Dask scheduler answers at {scheduler!r} ({exc})") from None
         return c, [c]
     cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                            dashboard_address=":0", silence_logs=logging.ERROR)
@@ -467,6 +471,8 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
     ``retry_failed``: rerun failed cases too (cases that lost their worker always rerun);
     ``window``: cases in flight at once (default: twice the worker threads).
     """
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise InputError("command line", None, "--workers", f"expected a positive whole number, found {workers!r}")
     batch = cases if isinstance(cases, Batch) else load_cases(cases)
     if series is not None:
         batch.series = series
@@ -477,6 +483,8 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
     ids = []
     bar = Progress(len(batch), enabled=progress)
     client_, closing = None, []
+    if scheduler and client is None:   # a wrong address is told before anything is built
+        client_, closing = _open_client(None, scheduler, None)
 
     def record(cid, knobs, variant, result):
         (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
@@ -504,12 +512,13 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
             if error:
                 record(cid, knobs, variant, {"status": "failed", "error": error, "wall_s": None, "stats": {}})
                 continue
-            if client_ is None:
+            if ac is None:
                 from distributed import as_completed
-                client_, closing = _open_client(client, scheduler, workers)
+                if client_ is None:
+                    client_, closing = _open_client(client, scheduler, workers)
                 bar.t0 = time.perf_counter()   # the estimate counts case time, not start-up
                 ac = as_completed()
-                threads = sum(w.get("nthreads", 1) for w in client_.scheduler_info()["workers"].values())
+                threads = sum(client_.nthreads().values())
                 window = window or max(2, 2 * threads)
             shared = variants.builds[variant.id]
             if shared.blob is None:   # the FMUs go to the workers once per build, as bytes
