@@ -55,6 +55,8 @@ def runtime_files():
         if rel in seen or rel == Path("__init__.py"):   # the runtime has an __init__ of its own
             continue
         seen.add(rel)
+        if rel == Path("__init__.py"):
+            continue   # replaced by RUNTIME_INIT: the package's own imports (its public API) stay out
         here = list(rel.parent.parts)
         for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
             if not (isinstance(node, ast.ImportFrom) and node.level):
