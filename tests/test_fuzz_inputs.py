@@ -7,9 +7,7 @@ import io
 import random
 import re
 import shutil
-from pathlib import Path
 
-import pytest
 
 from conftest import MODELS, ROOT
 from hydrofmu.cli import main

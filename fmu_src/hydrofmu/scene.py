@@ -707,8 +707,8 @@ def _current(problems, env):
     given = [k for k in ("current_profile", "current_deck") if k in env]
     uniform = [k for k in ("current_speed", "current_direction") if k in env]
     if len(given) > 1 or (given and uniform):
-        problems.add(f"environment.{(given + uniform)[1]}", f"give the current once: current_speed/current_direction "
-                                                            f"(uniform), current_profile or current_deck")
+        problems.add(f"environment.{(given + uniform)[1]}", "give the current once: current_speed/current_direction "
+                                                            "(uniform), current_profile or current_deck")
         return None, None, None
     if not given:
         return (problems.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),

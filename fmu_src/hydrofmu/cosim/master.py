@@ -172,7 +172,7 @@ class Exchange:
             links = [(s, svr, dvr) for s, d, svr, dvr in system.links if d == dst]
             if not links:
                 continue
-            port = self.write[dst] = inst[dst].port([v for _, _, dvr in links for v in dvr.tolist()])
+            self.write[dst] = inst[dst].port([v for _, _, dvr in links for v in dvr.tolist()])
             at, self.gather[dst] = 0, []
             for s, svr, dvr in links:
                 idx = np.array([where[s][v] for v in svr.tolist()])
