@@ -177,29 +177,33 @@ def test_fmus_one_level_equals_uniform_and_inputs_scale_the_profile(tmp_path):
     got, start = _loads(prof, "pro")
     assert start == (1.0, 0.0)                                   # the profile's surface values
     scaled, _ = _loads(prof, "pro", 2.0, 40.0)
-    # hand: body at z = -5 (AQWA's reference point), the clump at z = -35
-    #   z = -35: t = 15/80 → U = 0.4 − 0.1875·0.3 = 0.34375, β = 90°
+    hand_loads(got, 1.0, 0.0)
+    hand_loads(scaled, 2.0, 40.0)
+
+
+def hand_loads(out, k, turn):
+    """SCENE's loads of ``_loads`` by hand, with the inputs scaling the profile by ``k`` and
+    turning it by ``turn``: body at z = -5 (AQWA's reference point), the clump at z = -35
+    (t = 15/80 → U = 0.4 − 0.1875·0.3 = 0.34375, β = 90°)."""
     v = np.array([0.1, -0.2, 0.0])
-    for inputs, out in (((1.0, 0.0), got), ((2.0, 40.0), scaled)):
-        k, turn = inputs
-        uc = u(k * 0.34375, 90.0 + turn) - (v + np.cross([0, 0, 0.01], [0, 0, -30.0]))
-        np.testing.assert_allclose(out["clump"][:3], [100.0 * uc[0] * abs(uc[0]), 200.0 * uc[1] * abs(uc[1]), 0.0],
-                                   rtol=1e-12)
-        w = v - u(k * 0.85, 22.5 + turn)
-        np.testing.assert_allclose(out["viscous_drag"][:2], -np.array([1e4, 2e4]) * w[:2] * np.abs(w[:2]), rtol=1e-12)
+    uc = u(k * 0.34375, 90.0 + turn) - (v + np.cross([0, 0, 0.01], [0, 0, -30.0]))
+    np.testing.assert_allclose(out["clump"][:3], [100.0 * uc[0] * abs(uc[0]), 200.0 * uc[1] * abs(uc[1]), 0.0],
+                               rtol=1e-12)
+    w = v - u(k * 0.85, 22.5 + turn)
+    np.testing.assert_allclose(out["viscous_drag"][:2], -np.array([1e4, 2e4]) * w[:2] * np.abs(w[:2]), rtol=1e-12)
 
 
 # --- vendor files -------------------------------------------------------------------------
 def test_profiles_from_deeplines_and_sima_files(tmp_path):
     dl = tmp_path / "model.dat"
-    dl.write_text("*UNITS\n SI\n*CURRENT\n 1.0  0.\n*CURPROF\n 0.  1.0\n -20. 0.4  90.\n -100. 0.1 90\n*LINE\n x\n")
+    dl.write_text("*UNITS\n SI\n*CURPROF\n 0. -20. -100\n*CURRENT\n 0.  0. 1.0  90. 0.4 &\n 90 0.1\n*LINE\n x\n")
     sima = tmp_path / "current.txt"
     sima.write_text("' number of current levels\n3\n' zlevel direction current\n0.0 0.0 1.0\n"
                     "-20.0, 90.0, 0.4\n-1.0D2 90.0 0.1\n")
     assert read_current_profile(dl) == ROWS
     assert read_sima(sima) == ROWS
     uniform = tmp_path / "uniform.dat"
-    uniform.write_text("*CURRENT\n 0.7 120.\n")
+    uniform.write_text("*CURRENT\n 0. 120. 0.7\n")
     assert read_current_profile(uniform) == [[0.0, 0.7, 120.0]]
     for deck, fmt in ((dl, "deeplines"), (sima, "sima")):
         scene = load_scene(write_scene(tmp_path, SCENE.format(
@@ -208,10 +212,10 @@ def test_profiles_from_deeplines_and_sima_files(tmp_path):
 
 
 BAD_DEEPLINES = {
-    "level above the surface": ("*CURRENT\n 1.0 0.\n*CURPROF\n 2.0 1.0\n -20. 0.4\n", 4, "Z(1)", "above"),
-    "levels not ordered": ("*CURRENT\n 1.0 0.\n*CURPROF\n 0. 1.0\n -50. 0.4\n -20. 0.2\n", 6, "Z(3)", "ordered"),
-    "missing value": ("*CURRENT\n 1.0 0.\n*CURPROF\n 0. 1.0\n -20.\n", 5, "RATIO(2)", "missing"),
-    "missing direction": ("*CURRENT\n 1.0\n", 2, "DIRC", "missing"),
+    "level above the surface": ("*CURPROF\n 2.0 -20.\n*CURRENT\n 0. 0. 1.0 0. 0.4\n", 2, "ZCUR(1)", "above"),
+    "levels not ordered": ("*CURPROF\n 0. -50. -20.\n*CURRENT\n 0. 0. 1. 0. .4 0. .2\n", 2, "ZCUR(3)", "ordered"),
+    "missing value": ("*CURPROF\n 0. -20.\n*CURRENT\n 0. 0. 1.0 0.\n", 4, "VCUR(1,2)", "missing"),
+    "missing heading": ("*CURRENT\n 0.\n", 2, "TETC(1,1)", "missing"),
 }
 BAD_SIMA = {
     "level above the surface": ("2\n0.5 0.0 1.0\n-20. 90. 0.4\n", 2, "CURLEV(1)", "above"),
@@ -242,7 +246,7 @@ BAD_SCENE = {
     "missing value": ("current_profile = [[0.0, 1.0, 0.0], [-20.0, 0.4]]",
                       "environment.current_profile[1]", "missing value"),
     "deck level above the surface": ('current_deck = "bad.dat"\ncurrent_format = "deeplines"',
-                                     "environment.current_deck", "bad.dat:4: Z(1):"),
+                                     "environment.current_deck", "bad.dat:2: ZCUR(1):"),
     "zero at the surface only": ("current_profile = [[0.0, 0.0, 0.0], [-20.0, 0.4, 90.0]]",
                                  "environment.current_profile[0]", "speed: the speed at the top level is 0"),
     "negative speed": ("current_profile = [[0.0, 1.0, 0.0], [-20.0, -0.4, 90.0]]",
@@ -256,12 +260,18 @@ BAD_SCENE = {
 def test_malformed_scene_profile_is_one_error_and_nothing_is_written(tmp_path, case):
     current, key, match = BAD_SCENE[case]
     (tmp_path / "bad.dat").write_text(BAD_DEEPLINES["level above the surface"][0])
-    path = write_scene(tmp_path, SCENE.format(name="bad", current=current))
+    one_scene_error(write_scene(tmp_path, SCENE.format(name="bad", current=current)), key, match)
+
+
+def one_scene_error(path, key, match):
+    """Loading the scene ``path`` is one error at ``key`` saying ``match``; the CLI build
+    exits with 2, prints that one error line, no traceback, and writes nothing."""
     with pytest.raises(InputError) as err:
         load_scene(path)
     assert err.value.field == key and match in err.value.message and ";" not in err.value.message, str(err.value)
-    out = tmp_path / "out"
+    out = path.parent / "out"
     run = subprocess.run([sys.executable, "-m", "hydrofmu.cli", "build", str(path), "-o", str(out)],
                          capture_output=True, text=True)
-    assert run.returncode == 2 and key in run.stderr and "Traceback" not in run.stderr, run.stderr
+    assert run.returncode == 2 and key in run.stderr and match in run.stderr, run.stderr
+    assert "Traceback" not in run.stderr and run.stderr.count("error:") == 1
     assert not out.exists()

@@ -645,7 +645,7 @@ def load_scene(path, overrides=None):
         p.add("scene.name", f"scene name must be an identifier, found {name!r}")
     env = p.table(doc, "environment", "environment", required=False) or {}
     p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction", "current_profile",
-                                      "current_deck", "current_format"})
+                                      "current_deck", *CURRENT_DECK_KEYS})
     run = p.table(doc, "run", "run", required=False) or {}
     p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset"})
     preset = run.get("preset")
@@ -696,7 +696,9 @@ def load_scene(path, overrides=None):
 
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
-CURRENT_FORMATS = ("deeplines", "sima")
+CURRENT_FORMATS = ("deeplines", "sima", "riflex")
+# keys that go with current_deck; the last three only with current_format = "riflex"
+CURRENT_DECK_KEYS = ("current_format", "current_environment", "current_state", "current_units")
 
 
 def _current(problems, env):
@@ -705,6 +707,10 @@ def _current(problems, env):
     [z, speed, direction] rows, or a ``current_deck`` read by its ``current_format``."""
     from .physics.current import CurrentProfile, profile_problem
     given = [k for k in ("current_profile", "current_deck") if k in env]
+    loose = [k for k in CURRENT_DECK_KEYS if k in env]
+    if loose and "current_deck" not in env:
+        problems.add(f"environment.{loose[0]}", "goes with current_deck (the file the current is read from)")
+        return None, None, None
     uniform = [k for k in ("current_speed", "current_direction") if k in env]
     if len(given) > 1 or (given and uniform):
         problems.add(f"environment.{(given + uniform)[1]}", "give the current once: current_speed/current_direction "
@@ -749,19 +755,70 @@ def _profile_rows(problems, raw, where):
 
 
 def _current_deck(problems, env):
-    """Profile rows from a vendor file: DeepLines *CURRENT/*CURPROF or a SIMA (SIMO/RIFLEX)
-    current profile file; deck errors are recorded with their file, line and field."""
+    """Profile rows from a vendor file: DeepLines *CURRENT/*CURPROF, a SIMA (SIMO/RIFLEX)
+    current profile file, or a current state of a RIFLEX INPMOD file's environment; deck
+    errors are recorded with their file, line and field."""
     from .decks.deeplines import read_current_profile
     from .decks.simo import read_current_profile as read_sima
     fmt = problems.choice(env, "current_format", "environment.current_format", CURRENT_FORMATS)
     path = _deck_path(problems, env, "environment", "current_deck")
+    riflex_only = [k for k in CURRENT_DECK_KEYS[1:] if k in env]
+    if fmt is not None and fmt != "riflex" and riflex_only:
+        problems.add(f"environment.{riflex_only[0]}", 'only for current_format = "riflex" (an INPMOD file '
+                                                     'holds several environments and current states)')
+        return None
     if fmt is None or path is None:
         return None
+    if fmt == "riflex":
+        return _riflex_current(problems, env, path)
     try:
         return (read_current_profile if fmt == "deeplines" else read_sima)(path)
     except InputError as exc:
         problems.add("environment.current_deck", str(exc))
         return None
+
+
+def _riflex_current(problems, env, path):
+    """The profile of one ``NEW CURRENT STATE`` of a RIFLEX INPMOD file: the environment
+    ``current_environment`` (IDENV) and state ``current_state`` (ICUSTA), each optional
+    when the file has only one; ``current_units`` checked against the file's units line."""
+    from .decks.riflex import read_current_states
+    from .decks.units import SYSTEMS
+    units = None
+    if "current_units" in env:
+        units = problems.choice(env, "current_units", "environment.current_units", tuple(SYSTEMS))
+        if units is None:
+            return None
+    found = problems.deck(path, "environment.current_deck", read_current_states, units)
+    if found is None:
+        return None
+    envs = {k: v for k, v in found.items() if v}
+    name = env.get("current_environment")
+    if name is None:
+        if len(envs) != 1:
+            problems.add("environment.current_environment",
+                         f"{path.name} has {len(envs)} environments with a NEW CURRENT STATE"
+                         f"{' (' + ', '.join(envs) + '): name one' if envs else ''}")
+            return None
+        name = next(iter(envs))
+    elif not isinstance(name, str) or name not in envs:
+        problems.add("environment.current_environment",
+                     f"{name!r} is not an environment with a NEW CURRENT STATE in {path.name} "
+                     f"(it has: {', '.join(envs) or 'none'})")
+        return None
+    states = envs[name]
+    number = env.get("current_state")
+    if number is None:
+        if len(states) != 1:
+            problems.add("environment.current_state", f"environment {name!r} of {path.name} has {len(states)} "
+                                                      f"current states ({', '.join(map(str, states))}): name one")
+            return None
+        number = next(iter(states))
+    elif not isinstance(number, int) or isinstance(number, bool) or number not in states:
+        problems.add("environment.current_state", f"{number!r} is not a current state of environment {name!r} "
+                                                  f"in {path.name} (it has: {', '.join(map(str, states))})")
+        return None
+    return [list(r) for r in states[number].rows]
 
 
 def override(doc, key, value, path="scene"):

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .lines import check_profile, fields, read_lines
+from .lines import Line, check_profile, convert, fields, read_lines
 
 KEYWORD = "*CURRENTPOL"
 ROW = ("ANGC", "CXC", "CYC", "CMZC")
@@ -153,46 +153,82 @@ CURRENT, CURPROF = "*CURRENT", "*CURPROF"
 def read_current_profile(path):
     """The current of a DeepLines data file as profile rows [[z, speed, direction], ...].
 
-    hydrofmu's reading of the two keywords (the manual excerpt names them, not their data)::
+    ``*CURRENT`` as the DeepLines keyword list prints it (principia-support.com, List of
+    keywords, *CURRENT): one line per time, continued with ``&``,
+    ``TCUR TETC(1) VCUR(1) … TETC(NZCUR) VCUR(NZCUR)``: time [s], then per level the
+    heading [deg from +x, anticlockwise, the way the current goes: 180 = towards −x] and
+    the speed [m/s]; NZCUR = 1 (uniform) unless a ``*CURPROF`` precedes it.  One time line
+    is a steady current (its TCUR is not used; the manual's own example gives 1.); several
+    (a current changing in time) are refused: the master drives ``current.speed`` and
+    ``current.direction`` in time instead.
 
-        *CURRENT
-          VC  DIRC               surface speed [m/s], direction [deg, going to, CCW from +x]
-        *CURPROF                 (optional: without it the current is uniform)
-          Z  RATIO  [DIR]        one row per level: z ≤ 0 [m] (z up, 0 at the mean free surface),
-                                 speed RATIO·VC, direction DIR (default DIRC)
+    ``*CURPROF`` gives the levels ZCUR(1) … ZCUR(NZCUR).  Its data layout is not in the
+    public keyword list (only its name and NZCUR are, through *CURRENT): hydrofmu reads the
+    block as that list of level heights z [m] (global z up, 0 at the mean free surface, so
+    ≤ 0), on one or more lines.  Data may start on the keyword line.  A file written
+    otherwise (positive depths, a leading count) fails the checks below with an error, it
+    is never read silently wrong.  Other keywords are skipped.
 
-    Other keywords are skipped.  Raises InputError naming file, line and field.
-    """
-    lines = read_lines(path, comment=("!", "#"))
+    Raises InputError naming file, line and field (a level above the surface, levels not
+    ordered, a missing or extra value, *CURPROF after *CURRENT, several times)."""
+    lines = read_lines(path, comment=("!", "#"), continuation="&")
     blocks = {}
-    pos = 0
-    while pos < len(lines):
-        end = pos + 1
-        while end < len(lines) and not lines[end].text.startswith("*"):
-            end += 1
-        key = lines[pos].text.replace(" ", "").upper().split(",")[0]
-        if key in (CURRENT, CURPROF):
-            if key in blocks:
-                raise lines[pos].error(key, f"{key} given twice (first at line {blocks[key][0].number})")
-            blocks[key] = (lines[pos], lines[pos + 1:end])
-        pos = end
+    for pos, line in enumerate(lines):
+        if not line.text.startswith("*"):
+            continue
+        key = line.text.split()[0].replace(" ", "").upper().split(",")[0]
+        if key not in (CURRENT, CURPROF):
+            continue
+        if key in blocks:
+            raise line.error(key, f"{key} given twice (first at line {blocks[key][0].number})")
+        end = next((k for k in range(pos + 1, len(lines)) if lines[k].text.startswith("*")), len(lines))
+        blocks[key] = (line, _data(line, lines[pos + 1:end]))
     if CURRENT not in blocks:
         raise InputError(path, None, CURRENT, "no *CURRENT keyword in the file")
-    head, body = blocks[CURRENT]
-    if len(body) != 1:
-        at = body[1] if len(body) > 1 else head
-        raise at.error("VC", f"*CURRENT takes one line 'VC DIRC', found {len(body)}")
-    c = fields(body[0], ["VC", "DIRC"])
-    if CURPROF not in blocks:
-        rows, where = [[0.0, c["VC"], c["DIRC"]]], [(body[0], {"z": "VC", "speed": "VC", "direction": "DIRC"})]
+    head, rows = blocks[CURRENT]
+    if CURPROF in blocks:
+        prof_head, prof_rows = blocks[CURPROF]
+        if prof_head.number > head.number:
+            raise prof_head.error(CURPROF, f"*CURPROF must precede *CURRENT (line {head.number}): the manual "
+                                           f"reads *CURRENT with NZCUR = 1 otherwise")
+        levels = [(row.at_word(k), w) for row in prof_rows for k, w in enumerate(row.words)]
+        if not levels:
+            raise prof_head.error("ZCUR(1)", "*CURPROF has no level ZCUR(1) ... ZCUR(NZCUR)")
+        z = [(at, convert(at, f"ZCUR({j + 1})", w, float)) for j, (at, w) in enumerate(levels)]
     else:
-        head, body = blocks[CURPROF]
-        if not body:
-            raise head.error("Z", "*CURPROF has no 'Z RATIO [DIR]' row")
-        rows, where = [], []
-        for k, line in enumerate(body):
-            names = [f"Z({k + 1})", f"RATIO({k + 1})", f"DIR({k + 1})"]
-            v = fields(line, names, defaults={names[2]: c["DIRC"]})
-            rows.append([v[names[0]], v[names[1]] * c["VC"], v[names[2]]])
-            where.append((line, dict(zip(("z", "speed", "direction"), names))))
-    return check_profile(rows, where)
+        z = [(head, 0.0)]
+    if not rows:
+        raise head.error("TCUR(1)", "*CURRENT has no line 'TCUR TETC(1) VCUR(1) ...'")
+    if len(rows) > 1:
+        raise rows[1].error("TCUR(2)", f"*CURRENT gives {len(rows)} times: a current changing in time is not "
+                                       f"read (give one line and drive current.speed and current.direction "
+                                       f"from the master instead)")
+    row, n = rows[0], len(z)
+    names = ["TCUR(1)"] + [f"{f}(1,{j + 1})" for j in range(n) for f in ("TETC", "VCUR")]
+    words = row.words
+    if len(words) != len(names):
+        short = len(words) < len(names)
+        field_ = names[len(words)] if short else f"TETC(1,{n + 1})"
+        at = row.at_word(len(words) - 1 if short else len(names))
+        raise at.error(field_, f"{'missing value' if short else 'too many values'}: NZCUR = {n} level(s) "
+                               f"({'from *CURPROF' if CURPROF in blocks else 'no *CURPROF'}) takes 1 + 2·NZCUR = "
+                               f"{len(names)} values 'TCUR TETC VCUR ...', found {len(words)}")
+    values = [convert(row.at_word(k), name, w, float) for k, (name, w) in enumerate(zip(names, words))]
+    out, where = [], []
+    for j, (at_z, zj) in enumerate(z):
+        out.append([zj, values[2 + 2 * j], values[1 + 2 * j]])
+        where.append(({"z": at_z, "speed": row.at_word(2 + 2 * j), "direction": row.at_word(1 + 2 * j)},
+                      {"z": f"ZCUR({j + 1})" if CURPROF in blocks else "TCUR(1)",
+                       "speed": names[2 + 2 * j], "direction": names[1 + 2 * j]}))
+    return check_profile(out, where)
+
+
+def _data(head, body):
+    """Data lines of a keyword block; words after the keyword on its own line count as a
+    first data line (one line, as it was continued)."""
+    rest = head.text.split(None, 1)[1] if len(head.text.split(None, 1)) > 1 else ""
+    if not rest:
+        return list(body)
+    first = Line(head.path, head.number, rest, tuple((n, max(0, s - (len(head.text) - len(rest))))
+                                                     for n, s in head.pieces))
+    return [first] + list(body)

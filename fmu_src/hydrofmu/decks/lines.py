@@ -211,11 +211,12 @@ class Cursor:
 def check_profile(rows, where):
     """Check current profile rows [[z, speed, direction], ...] read from a file
     (physics.current.profile_problem); ``where[k]`` = (line, {"z": field, "speed": field,
-    "direction": field}) names the first problem's line and field."""
+    "direction": field}) names the first problem's line and field; ``line`` may be a dict
+    of lines by the same keys when a level's values sit on different lines."""
     from ..physics.current import profile_problem
     problem = profile_problem(*zip(*rows))
     if problem is not None:
         k, name, message = problem
         line, names = where[k]
-        raise line.error(names[name], message)
+        raise (line[name] if isinstance(line, dict) else line).error(names[name], message)
     return rows

@@ -1,4 +1,5 @@
-"""RIFLEX input: the BODY and CONB component data groups.
+"""RIFLEX input: the BODY and CONB component data groups, and the current states of the
+environments (``read_current_states``, layout at its definition below).
 
 Layout, one data group per component (keywords: first four letters of each word, any
 case; lines starting with ' are comments; commas separate like blanks)::
@@ -29,7 +30,7 @@ from dataclasses import dataclass, replace
 from ..errors import InputError
 from ..physics.lumped import LumpedBody, coordinate_code
 from . import units as unit_systems
-from .lines import Cursor, fields, fread_lines, is_end, is_keyword, keyword_key
+from .lines import Cursor, check_profile, fields, fread_lines, is_end, is_keyword, keyword_key
 
 HYDRO = ("ICOO", "CDX", "CDY", "CDZ", "AMX", "AMY", "AMZ")
 FREEDOM = ("IRX", "IRY", "IRZ")
@@ -85,7 +86,7 @@ def read_components(path, units="SI"):
         if is_end(line):
             break
         if is_keyword(line, UNITS):
-            system = unit_systems.riflex_units(_next_data(cur, ("UT", "UL", "UM", "UF", "GRAV", "GCONS"), UNITS))
+            system = _units(cur)
             continue
         kind = next((k for k, key in GROUPS.items() if is_keyword(line, key)), None)
         if kind is None:
@@ -101,6 +102,11 @@ def read_components(path, units="SI"):
     mass, force = unit_systems.factors(units)
     return {k: replace(c, am=c.am * mass, cd=tuple(x * force for x in c.cd),
                        added_mass=tuple(x * mass for x in c.added_mass)) for k, c in out.items()}
+
+
+def _units(cur):
+    """The declaration of the ``UNIT NAMe SPECification`` line that follows."""
+    return unit_systems.riflex_units(_next_data(cur, ("UT", "UL", "UM", "UF", "GRAV", "GCONS"), UNITS))
 
 
 def _next_data(cur, names, owner):
@@ -161,3 +167,122 @@ def _read_group(cur, head, kind, seen):
                 raise line.error(key, f"expected 0 (free) or 1 (fixed), found {values[key]}")
         codes = tuple(values[k] for k in FREEDOM)
     return ConbData(**common, codes=codes)
+
+
+# --- current profiles: environment data (INPMOD data group D) ------------------------------
+# Layout from the RIFLEX INPMOD input description, "Data Group D: Environmental Data"
+# (SINTEF Ocean's RIFLEX user manual): an environment is
+#   ENVIronment IDENtification / one text line (may be blank) / IDENV
+#   WATErdepth AND WAVEtype / WDEPTH NOIRW NORW NCUSTA NWISTA
+#   … waves, constants …
+#   NEW CURRENT STATE / ICUSTA NCULEV L_EXT / NCULEV lines CURLEV CURDIR CURVEL
+# (the last group repeated for each current state 1, 2, …, NCUSTA).  CURLEV: global z [L],
+# 0 at the mean water level, negative below, levels given with decreasing z; CURDIR: the
+# direction the current goes, degrees from global X counter-clockwise seen from above;
+# CURVEL [L/T]; linear between levels, constant outside.  1 ≤ NCULEV ≤ 30; L_EXT (default
+# 0) = 1 puts the levels in an external CURMOD file, which hydrofmu does not read.
+ENVIRONMENT = "ENVIronment IDENtification"
+WATER = "WATErdepth AND WAVEtype"
+CURRENT_STATE = "NEW CURRENT STATE"
+CURRENT_LINE = "NEW CURRENT LINE"
+
+
+@dataclass(frozen=True)
+class CurrentState:
+    """One ``NEW CURRENT STATE`` of an environment: profile ``rows`` [[z m, speed m/s,
+    direction deg going to], ...] from the top down; ``line``: its ICUSTA line."""
+    environment: str
+    number: int
+    rows: list
+    path: str
+    line: int
+
+
+def read_current_states(path, units=None):
+    """Every current state of a RIFLEX INPMOD file: {IDENV: {ICUSTA: CurrentState}}.
+
+    Other data groups are skipped (FREAD rules, ``END`` ends the input).  ``units``: the
+    scene's name for the file's unit system, checked against its ``UNIT NAMe
+    SPECification`` when given; CURLEV [L] and CURVEL [L/T] are m and m/s in every system
+    hydrofmu reads (decks/units.py checks UL = m and UT = s), so no value is scaled.
+    Raises InputError naming file, line and field (a level above the surface, levels not in
+    decreasing z, a missing value, a state out of order, …)."""
+    cur = Cursor(fread_lines(path), path)
+    out, env, ncusta, system = {}, None, None, None
+    while not cur.done():
+        line = cur.next("data group")
+        if is_end(line):
+            break
+        if is_keyword(line, UNITS):
+            system = _units(cur)
+        elif is_keyword(line, ENVIRONMENT):
+            env, ncusta = _environment(cur, line, out), None
+            out[env] = {}
+        elif is_keyword(line, WATER):
+            names = ("WDEPTH", "NOIRW", "NORW", "NCUSTA", "NWISTA")
+            values = fields(_next_data(cur, names, WATER), list(names), kind=[float, int, int, int, int],
+                            defaults={"NWISTA": 0})
+            ncusta = values["NCUSTA"]
+        elif is_keyword(line, CURRENT_STATE):
+            if env is None:
+                raise line.error("IDENV", f"{CURRENT_STATE!r} before any {ENVIRONMENT!r}: a current belongs "
+                                          f"to an environment")
+            state = _current_state(cur, env, out[env], ncusta)
+            out[env][state.number] = state
+    if units is not None:
+        unit_systems.check(system, units, path, key="current_units")
+    return out
+
+
+def _environment(cur, head, seen):
+    """IDENV of an ``ENVIronment IDENtification`` group: the text line (which may be blank,
+    and FREAD drops blank lines) then IDENV; the manual puts ``WATErdepth AND WAVEtype``
+    right after, which tells a blank text line from a given one."""
+    ident = cur.next("IDENV")              # the text line, or IDENV when the text line was blank
+    nxt = cur.peek()
+    if nxt is not None and not is_end(nxt) and not is_keyword(nxt, WATER):
+        ident = cur.next("IDENV")
+    if len(ident.words) != 1:
+        raise ident.error("IDENV", f"expected one environment identifier after the text line of "
+                                   f"{ENVIRONMENT!r} (line {head.number}), found {ident.text!r} (the manual puts "
+                                   f"{WATER!r} right after IDENV)")
+    name = ident.words[0]
+    if name in seen:
+        raise ident.error("IDENV", f"environment {name!r} given twice (each must have a unique identifier)")
+    return name
+
+
+def _current_state(cur, env, states, ncusta):
+    names = ("ICUSTA", "NCULEV", "L_EXT")
+    dim = _next_data(cur, names, CURRENT_STATE)
+    v = fields(dim, list(names), kind=int, defaults={"L_EXT": 0})
+    number, n = v["ICUSTA"], v["NCULEV"]
+    if number != len(states) + 1:
+        raise dim.error("ICUSTA", f"current states of environment {env!r} must be given as 1, 2, ...: "
+                                  f"expected {len(states) + 1}, found {number}")
+    if ncusta is not None and number > ncusta:
+        raise dim.error("ICUSTA", f"state {number} but NCUSTA = {ncusta} in {WATER!r} of environment {env!r}")
+    if not 1 <= n <= 30:
+        raise dim.error("NCULEV", f"number of current levels must be 1 ... 30, found {n}")
+    if v["L_EXT"] not in (0, 1):
+        raise dim.error("L_EXT", f"expected 0 (levels in this file) or 1 (external file), found {v['L_EXT']}")
+    if v["L_EXT"] == 1:
+        raise dim.error("L_EXT", "L_EXT = 1 puts the current levels in an external CURMOD file, which hydrofmu "
+                                 "does not read: give the NCULEV lines 'CURLEV CURDIR CURVEL' here (L_EXT = 0)")
+    rows, where = [], []
+    for k in range(n):
+        level = [f"CURLEV({k + 1})", f"CURDIR({k + 1})", f"CURVEL({k + 1})"]
+        nxt = cur.peek()
+        if nxt is None or starts_group(nxt):
+            at = nxt or cur.lines[-1]
+            raise at.error(level[0], f"NCULEV = {n} but {k} level line(s) 'CURLEV CURDIR CURVEL' given "
+                                     f"(found {at.text if nxt else 'the end of the file'!r})")
+        line = cur.next(level[0])
+        f = fields(line, level)
+        if k and f[level[0]] >= rows[-1][0]:
+            raise line.error(level[0], f"levels must be given with decreasing z (the manual): z = "
+                                       f"{f[level[0]]:g} follows z = {rows[-1][0]:g}")
+        rows.append([f[level[0]], f[level[2]], f[level[1]]])
+        where.append((line, dict(zip(("z", "direction", "speed"), level))))
+    check_profile(rows, where)
+    return CurrentState(env, number, rows, str(cur.path), dim.number)

@@ -25,7 +25,10 @@ identifiers, TIMDEL, NRETij and the dofs have no default.
 
 Whole files: a SIMO system description file holds many other data groups (``SYSTem
 DESCription SIMO``, body data, environment, …).  The reader picks out the groups above and
-skips every other line; ``END`` ends the file.  A line that starts like the coupling group
+skips every other line; ``END`` ends the file.  The environment (``ENVIronment DATA
+SPECification`` and its wave, wind and current groups) is skipped: the layout of its current
+group is not in any public material we found, so a SIMO current comes from SIMA's current
+file (``read_current_profile`` below) or the scene.  A line that starts like the coupling group
 (``HYDRodynamic COUPling …``) but is not it is an error, not skipped.  ``BODY DATA
 SPECification`` followed by the body identifier also declares a body.  The units line of
 ``SYSTem DESCription SIMO`` (LENUNI TIMUNI MASUNI GRAV RHOW …) is checked against the
@@ -294,8 +297,9 @@ def write_couplings(path, groups, header="SIMO hydrodynamic coupling data (SI un
 
 
 def read_current_profile(path):
-    """A SIMA current profile file (SIMO's and RIFLEX's "regular current from file") as
-    profile rows [[z, speed, direction], ...].  Layout (FREAD rules)::
+    """A SIMA current profile file (SIMO's and RIFLEX's "regular current from file", as SIMA's
+    SIMO pages document it) as profile rows [[z, speed, direction], ...].  Layout (FREAD
+    rules)::
 
         NCUR                        number of levels
         CURLEV CURDIR CURVEL        NCUR lines: global z [m] (z up, 0 at the mean free surface),

@@ -45,11 +45,12 @@ def factors(system):
     return SYSTEMS[system]
 
 
-def check(declared, system, path):
-    """Error (at the declaration) when a file declares another system than the scene's."""
+def check(declared, system, path, key="units"):
+    """Error (at the declaration) when a file declares another system than the scene's;
+    ``key``: the scene key that names it."""
     if declared is not None and declared.system != system:
         raise declared.line.error(declared.field, f"the file declares {declared.system} units but the scene reads "
-                                                  f"{path} as {system}: set units = \"{declared.system}\" for this "
+                                                  f"{path} as {system}: set {key} = \"{declared.system}\" for this "
                                                   f"file in the scene (or correct the file)")
 
 
