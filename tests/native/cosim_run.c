@@ -7,6 +7,8 @@
  * algorithm and step come from the file); STOP in seconds; STEP, in seconds, is the
  * fixed-step algorithm's step for an .ssp and must be 0 to take the file's; libcosim's
  * file observer writes one CSV per simulator into OUTDIR.  Exit 0 on success, else 1 with libcosim's error printed.
+ * libcosim logs to the console from severity COSIM_LOG_LEVEL on (0 trace … 3 warning, the
+ * default, … 5 fatal).
  * Declarations from libcosimc's cosim.h, written out so that only the library is needed.
  */
 #include <stdbool.h>
@@ -43,7 +45,8 @@ int main(int argc, char **argv) {
     const char *config = argv[1];
     int64_t stop = (int64_t)(atof(argv[2]) * 1e9 + 0.5), step = (int64_t)(atof(argv[3]) * 1e9 + 0.5);
     cosim_log_setup_simple_console_logging();
-    cosim_log_set_output_level(4); /* warnings and errors */
+    const char *level = getenv("COSIM_LOG_LEVEL");
+    cosim_log_set_output_level(level ? atoi(level) : 3); /* default: warnings and errors */
     size_t n = strlen(config);
     int ssp = n > 4 && strcmp(config + n - 4, ".ssp") == 0;
     cosim_execution *ex = !ssp ? cosim_osp_config_execution_create(config, true, 0)

@@ -1,6 +1,7 @@
 """Build the FMUs of a scene: one load FMU per floating body, holding only the effects the
 scene gives it, plus one dynamics-partner FMU per body; a manifest (instances,
-connections, run settings) for our masters, an OspSystemStructure.xml for libcosim and an
+connections, run settings, power bonds) for our masters, the OSP files for libcosim
+(``<model>_OspModelDescription.xml`` per FMU and OspSystemStructure.xml, fmi/osp.py) and an
 SSP file (``<scene>.ssp``, fmi/ssp.py) for any SSP importer.
 
 Each FMU is self-contained: its resources carry a copy of the hydrofmu runtime under a
@@ -20,10 +21,8 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
-from xml.etree import ElementTree as ET
-from xml.dom import minidom
 
-from . import model_description
+from . import model_description, osp
 from ..errors import InputError
 from .ssp import write_ssp
 from .. import description
@@ -204,7 +203,8 @@ def connections(system, slaves):
 
 
 def manifest(scene, system, conns):
-    """What our masters read (manifest.json): instances, routes, run settings, connections."""
+    """What our masters read (manifest.json): instances, routes, run settings, connections
+    and the power bonds (fmi.osp.scalar_bonds)."""
     return {
         "scene": scene.name, "source": str(scene.path), "run": scene.run,
         "instances": {i.name: {"fmu": f"{i.model_id}.fmu", "kind": i.kind, "body": i.body}
@@ -215,25 +215,8 @@ def manifest(scene, system, conns):
                                "memory_length": c.memory_length, "set": c.set} for c in scene.couplings},
         "order": [i.name for i in system.instances],
         "connections": conns,
+        "bonds": osp.scalar_bonds(osp.bonds(system)),
     }
-
-
-def osp_system_structure(scene, system, conns):
-    """OspSystemStructure.xml text: libcosim's description of the same system."""
-    ns = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
-    root = ET.Element("OspSystemStructure", xmlns=ns, version="0.1")
-    ET.SubElement(root, "StartTime").text = "0.0"
-    ET.SubElement(root, "BaseStepSize").text = repr(scene.run["step"])
-    ET.SubElement(root, "Algorithm").text = "fixedStep"
-    sims = ET.SubElement(root, "Simulators")
-    for inst in system.instances:
-        ET.SubElement(sims, "Simulator", name=inst.name, source=f"{inst.model_id}.fmu")
-    cons = ET.SubElement(root, "Connections")
-    for src, svar, dst, dvar in conns:
-        vc = ET.SubElement(cons, "VariableConnection")
-        ET.SubElement(vc, "Variable", simulator=src, name=svar)
-        ET.SubElement(vc, "Variable", simulator=dst, name=dvar)
-    return minidom.parseString(ET.tostring(root, encoding="unicode")).toprettyxml(indent="  ")
 
 
 def bem_results(scene):
@@ -287,10 +270,13 @@ def _build_into(scene, outdir, target, system, runtime, shim, log):
             fmu, slaves[inst.name] = build_fmu(inst, work, runtime, shim)
             log(f"built {fmu.name}")
         conns = connections(system, slaves)
+        bonds = osp.bonds(system)
         result = work / "fmus"
         report_bem(scene, log, result)
         (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns), indent=2))
-        (result / "OspSystemStructure.xml").write_text(osp_system_structure(scene, system, conns))
+        for model_id, text in osp.model_descriptions(system, slaves, bonds).items():
+            (result / f"{model_id}_OspModelDescription.xml").write_bytes(text)
+        (result / "OspSystemStructure.xml").write_text(osp.system_structure(system, conns, bonds, scene.run["step"]))
         write_ssp(result / f"{scene.name}.ssp", scene.name,
                   {i.name: result / f"{i.model_id}.fmu" for i in system.instances}, conns,
                   scene.run["stop"], scene.run["step"])

@@ -29,6 +29,15 @@ ORDER = ["ModelExchange", "CoSimulation", "UnitDefinitions", "TypeDefinitions", 
          "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure"]
 
 
+def base_unit(unit):
+    """BaseUnit attributes of a unit of UNITS (SI exponents, factor when not 1)."""
+    exps, factor = UNITS[unit]
+    base = {k: str(v) for k, v in exps.items()}
+    if factor != 1.0:
+        base["factor"] = repr(factor)
+    return base
+
+
 def complete(xml_text, units, dependencies, description=None):
     """Return modelDescription.xml text with units and a full ModelStructure.
 
@@ -58,12 +67,7 @@ def complete(xml_text, units, dependencies, description=None):
     if used:
         defs = ET.Element("UnitDefinitions")
         for unit in sorted(used):
-            exps, factor = UNITS[unit]
-            u = ET.SubElement(defs, "Unit", name=unit)
-            base = {k: str(v) for k, v in exps.items()}
-            if factor != 1.0:
-                base["factor"] = repr(factor)
-            ET.SubElement(u, "BaseUnit", base)
+            ET.SubElement(ET.SubElement(defs, "Unit", name=unit), "BaseUnit", base_unit(unit))
         root.append(defs)
 
     for old in root.findall("ModelStructure"):
