@@ -25,8 +25,8 @@ from test_current_profile import ROWS, SCENE, _loads, hand_loads, one_scene_erro
 # defaults by '/': s m kg kN 9.81 0.001), a riser and a BODY component, then data group D:
 # two environments, the first with waves, constants and two current states, the second
 # with a blank text line and no current; END and what follows is not read.  State 1 uses
-# the FREAD conventions: '/' for L_EXT's default, commas, '&' continuation, comments, a D
-# exponent, and lower-case full words for the group identifier.
+# the FREAD conventions: '/' for L_EXT's default, commas, a tab, '&' continuation, comments,
+# a D exponent, and lower-case full words for the group identifier.
 RIFLEX = """\
 INPMod IDENtification TEXT 4.0
 current states among other data groups, from the RIFLEX manual's layouts
@@ -63,7 +63,7 @@ new current state                ' full words, lower case
 1 3 /
 ' CURLEV CURDIR CURVEL
 {level1}
--20.0 90.0 &
+-20.0	90.0 &
  0.4                             ' continued
 -1.0D2, 90.0, 0.1
 NEW CURRent STATe
