@@ -17,9 +17,80 @@ from xml.etree import ElementTree as ET
 import numpy as np
 import pytest
 
+from conftest import build
 from test_native import SCENES, clean_env, hosts, scenes  # noqa: F401 (fixtures)
 
 pytest.importorskip("libcosimpy")
+
+# beside models/: a buoy with explicit acceleration loads held to the earth by a joint
+# (a connector with side A only) and tied to a ship by a second joint (soft springs given:
+# the default ones, sized for Gauss–Seidel, let this light buoy's pitch diverge under Jacobi)
+EXTRA = """
+    [scene]
+    name = "earth_explicit"
+    [run]
+    step = 0.1
+    substep = 0.05
+    [bodies.buoy]
+    mass = 2.0e5
+    inertia = [1e7, 1e7, 2e7]
+    acceleration_loads = "explicit"
+    stiffness = [0.0, 0.0, 3.0e5, 1e8, 1e8, 0.0]
+    damping = [1e4, 1e4, 1e4, 1e6, 1e6, 1e6]
+    [[bodies.buoy.effects]]
+    type = "riflex_body"
+    name = "sphere"
+    offset = [0.0, 0.0, -2.0]
+    am = 2.0e3
+    ae = 10.0
+    icoo = "GLOBAL"
+    cd = [1e3, 1e3, 2e3]
+    [bodies.ship]
+    position = [30.0, 0.0, 0.0]
+    mass = 1.0e6
+    inertia = [1e8, 2e8, 3e8]
+    stiffness = [1e5, 1e5, 1e7, 1e9, 1e9, 1e8]
+    [[bodies.ship.effects]]
+    type = "riflex_body"
+    name = "weight"
+    offset = [0.0, 0.0, 0.0]
+    am = 1.0e3
+    ae = 0.0
+    icoo = "GLOBAL"
+    cd = [0.0, 0.0, 0.0]
+    [joints.anchor]
+    type = "riflex_conb"
+    a = "buoy"
+    a_point = [0.0, 0.0, -5.0]
+    b = "earth"
+    codes = [1, 1, 1]
+    stiffness = 1.0e4
+    damping = 1.0e4
+    rot_stiffness = 1.0e5
+    rot_damping = 1.0e5
+    acceleration_loads = "explicit"
+    am = 1.0e3
+    ae = 0.5
+    icoo = "GLOBAL"
+    cd = [10.0, 10.0, 10.0]
+    [joints.hawser]
+    type = "riflex_conb"
+    a = "ship"
+    a_point = [-10.0, 0.0, 0.0]
+    b = "buoy"
+    codes = [0, 0, 0]
+    stiffness = 1.0e4
+    damping = 1.0e4
+    """
+ALL = SCENES + ["earth_explicit"]
+# counted by hand from the scene files: bonds (load or joint side, dynamics side) per scene
+BONDS = {"moored_barge": 1, "side_by_side": 2, "joined_barges": 4, "earth_explicit": 5}
+
+
+@pytest.fixture(scope="module")
+def built(scenes, tmp_path_factory):  # noqa: F811
+    """Every scene of models/ and EXTRA, built: {name: folder}."""
+    return {**scenes, "earth_explicit": build(tmp_path_factory.mktemp("extra"), EXTRA)}
 
 # -- OSP-IS 1.0.1, the schema's names -----------------------------------------------------
 NS = "https://open-simulation-platform.com/OspModelDescription/1.0.1"
@@ -102,14 +173,13 @@ def check_osp_is(path, variables, fmu_units):
     return ports, leaves
 
 
-def test_every_fmu_has_an_osp_is_model_description(scenes):
+def test_every_fmu_has_an_osp_is_model_description(built):
     """Beside each FMU, ``<modelName>_OspModelDescription.xml`` (where libcosim looks): it
     parses as OSP-IS 1.0.1; every port pairs a Force with a LinearVelocity (Torque with
     AngularVelocity) of opposite causality, the three global components of each with units
     N, m/s (N·m, rad/s); every load and joint FMU has one port pair per body side, force out."""
     seen = 0
-    for name in SCENES:
-        folder = scenes[name]
+    for name, folder in built.items():
         manifest = json.loads((folder / "manifest.json").read_text())
         assert sorted(p.name for p in folder.glob("*_OspModelDescription.xml")) == sorted(
             f"{fmu_variables(folder / i['fmu'])[0]}_OspModelDescription.xml" for i in manifest["instances"].values())
@@ -133,7 +203,7 @@ def test_every_fmu_has_an_osp_is_model_description(scenes):
             sides = ([f"{dp}" for dyn, dp in manifest["dynamics"].values() if dyn == inst] if info["kind"] == "dynamics"
                      else {"load": [""], "joint": ["A."]}[info["kind"]])
             assert all(leaves[f"{p}position"] == "LinearDisplacement" for p in sides)
-    assert seen == 4 + 8 + 16   # moored (load, dynamics); side by side (two loads, one group); joined (+ joint)
+    assert seen == 4 * sum(BONDS.values())   # two ports on each end of each bond
 
 
 def parse_structure(path):
@@ -153,17 +223,16 @@ def port_variables(folder, manifest, instance):
             for p in root.find(q("VariableGroups")) if p.tag.split("}")[1] in PORTS}
 
 
-def test_bonds_link_an_out_force_port_to_an_in_force_port_of_the_same_body(scenes):
+def test_bonds_link_an_out_force_port_to_an_in_force_port_of_the_same_body(built):
     """Every VariableGroupConnection of OspSystemStructure.xml is a power bond: two ports of
     one type, force out (a load or joint FMU) and force in (a dynamics FMU), on one body (the
     dynamics body whose position feeds the load side's motion prefix); the plain and the
     expanded port connections are exactly the build's connections, each once."""
     from fmpy import read_model_description
-    for name in SCENES:
-        folder = scenes[name]
+    for name, folder in built.items():
         manifest = json.loads((folder / "manifest.json").read_text())
         _, plain, groups = parse_structure(folder / "OspSystemStructure.xml")
-        assert groups, name
+        assert len(groups) == 2 * BONDS[name], name
         expanded = []
         causal = {i: {v.name: v.causality for v in read_model_description(str(folder / x["fmu"])).modelVariables}
                   for i, x in manifest["instances"].items()}
@@ -231,14 +300,13 @@ LIBCOSIMPY_RUN = textwrap.dedent("""
 """)
 
 
-def test_libcosimpy_builds_the_bonded_system_without_warning_and_runs_as_before(scenes, tmp_path):
+def test_libcosimpy_builds_the_bonded_system_without_warning_and_runs_as_before(built):
     """libcosimpy loads every scene's OspSystemStructure.xml (ports and plain connections)
     with its log at INFO: the log reaches us (libcosim's 'Configuring algorithm' line) and
     holds no warning or error; 20 steps of it equal, to the bit, the same system written as
     plain scalar connections (the file before ports)."""
     paths = []
-    for name in SCENES:
-        folder = scenes[name]
+    for folder in built.values():
         manifest = json.loads((folder / "manifest.json").read_text())
         paths += [str(folder / "OspSystemStructure.xml"), str(old_structure(folder, manifest, folder / "plain.xml"))]
     step = 0.05   # every scene's step divides it: 20 of the smallest
@@ -280,12 +348,12 @@ def host_tables(hosts, config, stop, out, level):  # noqa: F811
     return run.stdout + run.stderr, tables
 
 
-@pytest.mark.parametrize("name", SCENES)
-def test_native_libcosim_host_builds_the_bonded_system_without_warning(name, scenes, hosts, tmp_path):  # noqa: F811
+@pytest.mark.parametrize("name", ALL)
+def test_native_libcosim_host_builds_the_bonded_system_without_warning(name, built, hosts, tmp_path):  # noqa: F811
     """The C host (libcosimc.so, no Python of its own) on the bonded OspSystemStructure.xml,
     log at INFO: no warning or error; its file observer's tables equal those of the same
     system as plain connections."""
-    folder = scenes[name]
+    folder = built[name]
     manifest = json.loads((folder / "manifest.json").read_text())
     stop = 20 * manifest["run"]["step"]
     log, new = host_tables(hosts, folder / "OspSystemStructure.xml", stop, tmp_path / "new", 2)
@@ -328,15 +396,15 @@ ECCO_BUILD = textwrap.dedent("""
 """)
 
 
-def test_libcosim_ecco_takes_every_bond_of_the_manifest(scenes):
+def test_libcosim_ecco_takes_every_bond_of_the_manifest(built):
     """The manifest's scalar bonds are what libcosim's ECCO algorithm takes (through its API:
     see fmi.osp for why not through the file): every one is accepted by ``add_power_bond``
     (the same velocity output may close several bonds), and the execution builds and steps
     with no warning or error in libcosim's log."""
-    run = subprocess.run([sys.executable, "-c", ECCO_BUILD] + [str(scenes[n]) for n in SCENES],
+    run = subprocess.run([sys.executable, "-c", ECCO_BUILD] + [str(f) for f in built.values()],
                          capture_output=True, text=True, timeout=300)
     log = run.stdout + run.stderr
     assert run.returncode == 0, log
     assert sorted(line.split()[1:] for line in log.splitlines() if line.startswith("BONDS")) == sorted(
-        [n, str(6 * k)] for n, k in (("moored_barge", 1), ("joined_barges", 4), ("side_by_side", 2)))
+        [n, str(6 * k)] for n, k in BONDS.items())
     assert not [line for line in log.splitlines() if "[warning]" in line or "[error]" in line], log
