@@ -76,7 +76,7 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
 
 
 def run(source: str | Path | Scene, *, stop: float | None = None, step: float | None = None,
-        algorithm: str | None = None, engine: str = "fmpy", out: str | Path = DEFAULT_OUT,
+        algorithm: str | None = None, engine: str | None = None, out: str | Path = DEFAULT_OUT,
         record: Sequence[str] | None = None, parameters: Mapping[str, float] | None = None,
         log: Callable[[str], object] = print) -> Result:
     """Run a scene: one call from a scene file (built first) or a built folder to a Result.
@@ -89,12 +89,13 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     stop, step : float, optional
         End time and communication step [s]; default: the scene's ``[run]`` settings
         (its preset's, unless the scene sets them).
-    algorithm : {'gauss-seidel', 'jacobi'}, optional
-        Master algorithm of the fmpy engine (libcosim is always Jacobi); default: the
-        scene's.
-    engine : {'fmpy', 'libcosim'}, default 'fmpy'
+    algorithm : {'gauss-seidel', 'jacobi', 'ecco'}, optional
+        Master algorithm; default: the scene's.  fmpy runs Jacobi and Gauss–Seidel,
+        libcosim Jacobi and ECCO (adaptive step, the scene's ``[run.ecco]`` settings;
+        ``step`` is then its first step).
+    engine : {'fmpy', 'libcosim'}, optional
         hydrofmu's fmpy master, or the Open Simulation Platform's libcosim (needs
-        libcosimpy, in the ``test`` extra).
+        libcosimpy, in the ``test`` extra); default: libcosim for an ECCO run, else fmpy.
     out : str or Path, default ``build/fmus``
         Where a scene file is built (see `build`).
     record : sequence of str, optional
@@ -113,9 +114,11 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     folder = source
     if isinstance(source, Scene) or Path(source).suffix == ".toml":
         folder = build(source, out, log=log)
+    from .cosim.libcosim import engine_for
+    engine = engine_for(folder, algorithm, engine)
     if engine == "libcosim":
         from .cosim.libcosim import run as run_libcosim
-        return run_libcosim(folder, stop=stop, step=step, record=record)
+        return run_libcosim(folder, stop=stop, step=step, record=record, algorithm=algorithm)
     if engine != "fmpy":
         raise ValueError(f"engine must be 'fmpy' or 'libcosim', found {engine!r}")
     from .cosim.master import run as run_fmpy

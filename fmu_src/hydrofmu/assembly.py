@@ -156,7 +156,8 @@ def joint_spring(scene, joint, exported):
 
     m_a, i_a = effective(a, np.array(joint.a_point))
     m_b, i_b = effective(b, point_b) if b is not None else (None, None)
-    dt = scene.run["step"]
+    # the largest step the run takes: ECCO may grow its step up to max_step
+    dt = scene.run["ecco"]["max_step"] if scene.run.get("algorithm") == "ecco" else scene.run["step"]
     pick = lambda given, default: float(given) if given is not None else float(default)
     return d.JointSpring(
         point_a=np.array(joint.a_point, float), point_b=point_b,

@@ -55,11 +55,13 @@ def check_run(folder=None, csv=None, png=None, step=None, stop=None):
         raise InputError(folder, None, "scene", "not a scene .toml nor a built scene folder (no manifest.json)")
 
 
-def run_folder(folder, engine="fmpy", csv=None, png=None, **kw):
-    """Run a built scene folder with fmpy (our master) or libcosim; write CSV/PNG."""
+def run_folder(folder, engine=None, csv=None, png=None, **kw):
+    """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
+    an ECCO run, else fmpy); write CSV/PNG."""
+    from .cosim.libcosim import engine_for
     folder = Path(folder)
     check_run(folder, csv, png, kw.get("step"), kw.get("stop"))
-    if engine == "libcosim":
+    if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
     else:
         from .cosim.master import run
@@ -170,11 +172,14 @@ def make_parser():
                                    "default to the scene's [run] settings (its preset's).")
     r.add_argument("scene", metavar="SCENE", help="scene file (.toml, built into OUT first) or built scene folder")
     r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="where a .toml scene is built")
-    r.add_argument("--engine", choices=("fmpy", "libcosim"), default="fmpy",
-                   help="master: hydrofmu's fmpy master or libcosim (Jacobi only)")
-    r.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"),
-                   help="fmpy master algorithm (default: the scene's)")
-    r.add_argument("--step", type=float, metavar="S", help="communication step [s] (default: the scene's)")
+    r.add_argument("--engine", choices=("fmpy", "libcosim"),
+                   help="master: hydrofmu's fmpy master (Jacobi, Gauss-Seidel) or libcosim (Jacobi, ECCO); "
+                        "default: libcosim for an ECCO run, else fmpy")
+    r.add_argument("--algorithm", choices=("jacobi", "gauss-seidel", "ecco"),
+                   help="master algorithm (default: the scene's); ecco: libcosim's adaptive step, with the "
+                        "scene's [run.ecco] settings")
+    r.add_argument("--step", type=float, metavar="S",
+                   help="communication step [s], ECCO's first step (default: the scene's)")
     r.add_argument("--stop", type=float, metavar="T", help="end time [s] (default: the scene's)")
     r.add_argument("--csv", type=Path, metavar="FILE", help="CSV file to write (default: <folder>.csv)")
     r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")

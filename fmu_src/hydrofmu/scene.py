@@ -347,6 +347,14 @@ EFFECT_TYPES = {
 }
 
 RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "constant"}
+ALGORITHMS = ("jacobi", "gauss-seidel", "ecco")
+# libcosim's ECCO (energy-conservation-based co-simulation, Sadjina & Pedersen 2020): the
+# step adapts to the power-bond energy residual; `step` is its first step.  Names as in
+# OspSystemStructure.xml's <EccoConfiguration>, snake case; tolerances on the residual
+# energy per step: abs [J], rel (to the energy the bonds carry in that step).
+ECCO_DEFAULTS = {"rel_tolerance": 1e-3, "abs_tolerance": 1.0, "min_step": 0.005, "max_step": 0.2,
+                 "safety_factor": 0.8, "min_change_rate": 0.2, "max_change_rate": 1.5,
+                 "p_gain": 0.2, "i_gain": 0.15}
 MEMORY_DEFAULTS = {"method": "convolution", "tolerance": 0.01, "memory_length": None}
 
 # Speed/accuracy presets a scene names with [run] preset = "…": each sets the run knobs
@@ -359,7 +367,33 @@ PRESETS = {
                "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None}},
     "reference": {"step": 0.01, "algorithm": "gauss-seidel", "substep": 0.005, "load_hold": "linear",
                   "memory": {"method": "convolution", "tolerance": 0.01, "memory_length": None}},
+    "adaptive": {"step": 0.05, "algorithm": "ecco", "substep": 0.01, "load_hold": "linear",
+                 "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None},
+                 "ecco": dict(ECCO_DEFAULTS)},
 }
+
+
+def _ecco(p, run, base, step):
+    """The ECCO settings of ``[run.ecco]`` over the preset's (or the defaults), checked."""
+    table = p.table(run, "ecco", "run.ecco", required=False) or {}
+    p.known_keys(table, "run.ecco", set(ECCO_DEFAULTS))
+    out = {k: p.number(table, k, f"run.ecco.{k}", v, positive=True)
+           for k, v in base.get("ecco", ECCO_DEFAULTS).items()}
+    if None in out.values():
+        return out
+    lo, hi = out["min_step"], out["max_step"]
+    if lo > hi:
+        p.add("run.ecco.min_step", f"must not exceed max_step ({hi:g} s), found {lo:g}")
+    elif step is not None and not lo <= step <= hi:
+        p.add("run.step", f"ECCO's first step must lie within [min_step, max_step] = [{lo:g}, {hi:g}] s, "
+                          f"found {step:g}")
+    if out["safety_factor"] > 1:
+        p.add("run.ecco.safety_factor", f"must be in (0, 1], found {out['safety_factor']:g}")
+    if out["min_change_rate"] > 1:
+        p.add("run.ecco.min_change_rate", f"must be in (0, 1], found {out['min_change_rate']:g}")
+    if out["max_change_rate"] < 1:
+        p.add("run.ecco.max_change_rate", f"must be at least 1, found {out['max_change_rate']:g}")
+    return out
 
 
 COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length", "units"}
@@ -647,7 +681,7 @@ def load_scene(path, overrides=None):
     p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction", "current_profile",
                                       "current_deck", *CURRENT_DECK_KEYS})
     run = p.table(doc, "run", "run", required=False) or {}
-    p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset"})
+    p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset", "ecco"})
     preset = run.get("preset")
     if preset is not None and preset not in PRESETS:
         p.add("run.preset", f"expected one of {', '.join(map(repr, PRESETS))}, found {preset!r}")
@@ -657,12 +691,15 @@ def load_scene(path, overrides=None):
         "preset": preset,
         "step": p.number(run, "step", "run.step", base["step"], positive=True),
         "stop": p.number(run, "stop", "run.stop", base["stop"], positive=True),
-        "algorithm": p.choice(run, "algorithm", "run.algorithm", ("jacobi", "gauss-seidel"), base["algorithm"]),
+        "algorithm": p.choice(run, "algorithm", "run.algorithm", ALGORITHMS, base["algorithm"]),
         "substep": p.number(run, "substep", "run.substep", base["substep"], positive=True),
         "load_hold": p.choice(run, "load_hold", "run.load_hold", ("constant", "linear"), base["load_hold"]),
         "memory": dict(base.get("memory", MEMORY_DEFAULTS)),
         "set": sorted(k for k in run if k != "preset"),   # knobs the scene sets itself
     }
+    run_cfg["ecco"] = _ecco(p, run, base, run_cfg["step"] if run_cfg["algorithm"] == "ecco" else None)
+    if "ecco" in run and run_cfg["algorithm"] not in (None, "ecco"):
+        p.add("run.ecco", f"ECCO settings need algorithm = \"ecco\" (the run's algorithm is {run_cfg['algorithm']!r})")
     bodies_t = p.table(doc, "bodies", "bodies") or {}
     bodies = {}
     for bname, btable in bodies_t.items():

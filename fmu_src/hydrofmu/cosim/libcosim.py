@@ -1,9 +1,17 @@
 """Run a built scene in libcosim (the Open Simulation Platform's engine) via libcosimpy.
 
-libcosim's fixed-step algorithm is a Jacobi scheme: all slaves step, then outputs are
-copied to inputs.  So its results equal hydrofmu's fmpy master in ``jacobi`` mode, and a
-run asked to be Gauss–Seidel (by the scene or the caller) is refused rather than quietly
-run as Jacobi.  libcosim counts time in integer nanoseconds.
+Two of libcosim's algorithms:
+
+- ``jacobi``: its fixed-step algorithm, a Jacobi scheme (all slaves step, then outputs are
+  copied to inputs), so its results equal hydrofmu's fmpy master in ``jacobi`` mode.  A run
+  asked to be Gauss–Seidel is refused rather than quietly run as Jacobi.
+- ``ecco``: its energy-conservation-based algorithm (Sadjina & Pedersen 2020): Jacobi
+  exchanges, with the step adapted after each one to the energy residual of the power bonds
+  (``cosim.bonds``), which are added here through the API, one per force/velocity
+  component.  The run's ``[run.ecco]`` settings (scene or preset) give its tolerances and
+  step bounds; ``step`` is its first step.
+
+libcosim counts time in integer nanoseconds.
 """
 import json
 from pathlib import Path
@@ -11,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .bonds import columns, power_bonds
 from .master import run_settings
 from .result import Result, column_units
 
@@ -20,7 +29,10 @@ NS = 1_000_000_000
 def run(folder, stop=None, step=None, record=None, algorithm=None):
     """Run the scene built in ``folder`` (its manifest.json) in libcosim; returns a Result
     with the same columns as cosim.master.run (default: every output of every FMU).
-    ``algorithm`` (default: the scene's) must be 'jacobi': InputError otherwise."""
+    ``algorithm`` (default: the scene's) must be 'jacobi' or 'ecco': InputError otherwise.
+    An ECCO run's time points are the ones it chose; it ends at the first at or after
+    ``stop``, and its Result records every power bond's force and velocity too."""
+    from libcosimpy.CosimAlgorithm import CosimAlgorithm, EccoParams
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -31,17 +43,28 @@ def run(folder, stop=None, step=None, record=None, algorithm=None):
     folder = Path(folder)
     manifest = json.loads((folder / "manifest.json").read_text())
     wanted = algorithm or manifest["run"]["algorithm"]
-    if wanted != "jacobi":
+    if wanted not in ("jacobi", "ecco"):
         where = "--algorithm" if algorithm else folder / "manifest.json"
         raise InputError(where, None, "algorithm", f"libcosim's fixed-step master is a Jacobi scheme and cannot "
                          f"run '{wanted}' (the scene's or the run's choice); run with the fmpy engine, "
-                         "or ask for Jacobi explicitly (--algorithm jacobi, algorithm='jacobi')")
+                         "or ask for Jacobi explicitly (--algorithm jacobi, algorithm='jacobi'), or for "
+                         "libcosim's adaptive ECCO (--algorithm ecco)")
     stop = manifest["run"]["stop"] if stop is None else stop
     step = manifest["run"]["step"] if step is None else step
     step_ns = int(round(step * NS))
-    n = int(round(stop / step))
-
-    execution = CosimExecution.from_step_size(step_size=step_ns)
+    settings = run_settings(manifest, step, wanted, stop)
+    if wanted == "ecco":
+        ecco = settings["ecco"]
+        if not ecco["min_step"] <= step <= ecco["max_step"]:
+            raise InputError("--step", None, "step", f"ECCO's first step must lie within [min_step, max_step] = "
+                             f"[{ecco['min_step']:g}, {ecco['max_step']:g}] s, found {step:g}")
+        algo = CosimAlgorithm.create_ecco_algorithm(ecco_params(EccoParams, ecco, step))
+        execution = CosimExecution.from_algorithm(algo)
+        capacity = int(np.ceil(stop / ecco["min_step"])) + 3   # most steps ECCO can take
+    else:
+        execution = CosimExecution.from_step_size(step_size=step_ns)
+        n = int(round(stop / step))
+        capacity = n + 1
     index, refs, outputs = {}, {}, {}
     for name in manifest["order"]:
         fmu = str((folder / manifest["instances"][name]["fmu"]).resolve())
@@ -53,42 +76,87 @@ def run(folder, stop=None, step=None, record=None, algorithm=None):
         refs[name] = {v.name.decode(): v.reference for v in variables}
         outputs[name] = [v.name.decode() for v in variables if v.causality == 2]  # 2 = output
     for src, svar, dst, dvar in manifest["connections"]:
-        if execution.connect_real_variables(index[src], refs[src][svar], index[dst], refs[dst][dvar]) is False:
+        if execution.connect_real_variables(index[src], refs[src][svar], index[dst], refs[dst][dvar]) != 0:
             raise RuntimeError(f"libcosim could not connect {src}.{svar} -> {dst}.{dvar}")
     if record is None:
         record = [f"{name}.{var}" for name in manifest["order"] for var in outputs[name]]
+    record = list(record)
+    if wanted == "ecco":
+        bonds = power_bonds(manifest)
+        if not bonds:
+            raise InputError(folder / "manifest.json", None, "connections",
+                             "ECCO needs power bonds (a force sent to a dynamics FMU and its velocity back); "
+                             "this scene has none")
+        for b in bonds:
+            if algo.add_power_bond(index[b.load], refs[b.load][b.force], refs[b.load][b.velocity],
+                                   index[b.dynamics], refs[b.dynamics][b.dyn_velocity],
+                                   refs[b.dynamics][b.dyn_force]) != 0:
+                raise RuntimeError(f"libcosim could not add the power bond {b.load}.{b.force} <-> "
+                                   f"{b.dynamics}.{b.dyn_velocity}")
+        record += [c for c in columns(bonds) if c not in record]
 
-    series = CosimObserver.create_time_series(buffer_size=n + 2)
+    series = CosimObserver.create_time_series(buffer_size=capacity + 1)
     execution.add_observer(series)
     for col in record:
         name, var = col.split(".", 1)
         series.start_time_series(index[name], refs[name][var], CosimVariableType.REAL)
-    if not execution.simulate_until(target_time=n * step_ns):
-        raise RuntimeError("libcosim stopped before the end time (an FMU reported an error)")
+    if wanted == "ecco":   # ECCO reads the bonds' inputs too, and libcosim reads only what is observed
+        for b in bonds:
+            for name, var in ((b.load, b.velocity), (b.dynamics, b.dyn_force)):
+                series.start_time_series(index[name], refs[name][var], CosimVariableType.REAL)
+    if not execution.simulate_until(target_time=int(round(stop * NS)) if wanted == "ecco" else n * step_ns):
+        from libcosimpy._internal import get_last_error_message
+        why = "; ".join(line.strip() for line in get_last_error_message().splitlines() if line.strip())
+        raise RuntimeError(f"libcosim stopped before the end time: {why}")
 
-    values = np.empty((n + 1, len(record)))
-    for j, col in enumerate(record):
+    values = []
+    for col in record:
         name, var = col.split(".", 1)
-        values[:, j] = _samples(series, index[name], refs[name][var], n)
-    return Result(np.arange(n + 1) * step, list(record), values, "libcosim", step, manifest["dynamics"],
-                  run_settings(manifest, step, "jacobi", stop), column_units(folder, manifest, record), manifest)
+        v, times = _samples(series, index[name], refs[name][var], capacity)
+        if wanted != "ecco" and v.size != n + 1:
+            raise RuntimeError(f"libcosim returned {v.size} samples for {n + 1} communication points")
+        values.append(v)
+    if wanted == "ecco":
+        time = times / NS
+        step = float(np.mean(np.diff(time))) if time.size > 1 else step
+    else:
+        time = np.arange(n + 1) * step
+    return Result(time, record, np.column_stack(values), wanted if wanted == "ecco" else "libcosim", step,
+                  manifest["dynamics"], settings, column_units(folder, manifest, record), manifest)
 
 
-def _samples(series, slave, ref, n):
-    """Values at steps 0..n of one time series.  Called through the C API directly:
-    libcosimpy's wrapper trims its result by counting step numbers equal to 0, which
-    drops the initial sample."""
+def engine_for(folder, algorithm=None, engine=None):
+    """The engine a run uses: ``engine`` when given, else libcosim for an ECCO run (the
+    run's ``algorithm`` or the scene's) and hydrofmu's fmpy master otherwise."""
+    if engine is not None:
+        return engine
+    if algorithm is None:
+        algorithm = json.loads((Path(folder) / "manifest.json").read_text())["run"]["algorithm"]
+    return "libcosim" if algorithm == "ecco" else "fmpy"
+
+
+def ecco_params(params, ecco, step):
+    """libcosimpy's EccoParams from a run's ``ecco`` settings and first step [s]."""
+    return params(safety_factor=ecco["safety_factor"], step_size=step, min_step_size=ecco["min_step"],
+                  max_step_size=ecco["max_step"], min_change_rate=ecco["min_change_rate"],
+                  max_change_rate=ecco["max_change_rate"], abs_tolerance=ecco["abs_tolerance"],
+                  rel_tolerance=ecco["rel_tolerance"], p_gain=ecco["p_gain"], i_gain=ecco["i_gain"])
+
+
+def _samples(series, slave, ref, capacity):
+    """(values, times in ns) of one time series, from step 0 on (every step recorded:
+    ``capacity`` holds them all).  Called through the C API directly: libcosimpy's wrapper
+    trims its result by counting step numbers equal to 0, which drops the initial sample."""
     from ctypes import POINTER, c_double, c_int, c_int64, c_size_t, c_uint32
     from libcosimpy._internal import libcosimc, wrap_function
     from libcosimpy.CosimObserver import CosimObserver
 
-    count = n + 1
     get = wrap_function(lib=libcosimc(), funcname="cosim_observer_slave_get_real_samples",
                         argtypes=[POINTER(CosimObserver), c_int, c_uint32, c_int64, c_size_t,
-                                  c_double * count, c_int64 * count, c_int64 * count],
+                                  c_double * capacity, c_int64 * capacity, c_int64 * capacity],
                         restype=c_int64)
-    values, steps, times = (c_double * count)(), (c_int64 * count)(), (c_int64 * count)()
-    got = get(series.ptr(), slave, ref, 0, count, values, steps, times)
-    if got != count or list(steps) != list(range(count)):
-        raise RuntimeError(f"libcosim returned {got} samples for {count} communication points")
-    return np.array(values[:])
+    values, steps, times = (c_double * capacity)(), (c_int64 * capacity)(), (c_int64 * capacity)()
+    got = get(series.ptr(), slave, ref, 0, capacity, values, steps, times)
+    if got < 1 or list(steps[:got]) != list(range(got)):
+        raise RuntimeError(f"libcosim returned {got} samples that are not steps 0, 1, 2, …")
+    return np.array(values[:got]), np.array(times[:got])

@@ -26,6 +26,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
+from ..errors import InputError
 from .result import Result
 
 
@@ -45,6 +46,9 @@ def run_settings(manifest, step=None, algorithm=None, stop=None):
             out[key] = value
             out["set"].append(f"{key} (run)")
     out["couplings"] = manifest.get("couplings", {})
+    if out["algorithm"] == "ecco":
+        from ..scene import ECCO_DEFAULTS
+        out["ecco"] = {**ECCO_DEFAULTS, **(cfg.get("ecco") or {})}
     return out
 
 
@@ -56,7 +60,11 @@ def describe(settings):
         + (f", memory {c['memory_length']:g} s" if c["memory_length"] else "")
         + (f" (set: {', '.join(c['set'])})" if c["set"] else "")
         for name, c in settings["couplings"].items())
-    return (f"preset {settings['preset'] or 'none'}: step {settings['step']:g} s, {settings['algorithm']}, "
+    ecco = settings.get("ecco")
+    algorithm = settings["algorithm"] + (
+        f" (steps {ecco['min_step']:g}–{ecco['max_step']:g} s, energy tolerance rel {ecco['rel_tolerance']:g}, "
+        f"abs {ecco['abs_tolerance']:g} J)" if ecco else "")
+    return (f"preset {settings['preset'] or 'none'}: {'first ' if ecco else ''}step {settings['step']:g} s, {algorithm}, "
             f"{settings['load_hold']} load hold, substep {settings['substep']:g} s"
             + (f"; set by the scene/run: {', '.join(settings['set'])}" if settings["set"] else "")
             + (f"; memory {memory}" if memory else ""))
@@ -295,6 +303,14 @@ def load(folder, parameters=None):
     return System(manifest, instances, parameters)
 
 
+def _check_algorithm(algorithm, where):
+    if algorithm == "ecco":
+        raise InputError(where, None, "algorithm", "ECCO (adaptive step) runs in libcosim only: use --engine "
+                         "libcosim (engine='libcosim'), or --algorithm jacobi / gauss-seidel here")
+    if algorithm not in ("jacobi", "gauss-seidel"):
+        raise ValueError(f"unknown algorithm {algorithm!r}")
+
+
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
         on_step=None):
     """Run a built scene (its folder), or a loaded ``System`` (initialised here, left loaded
@@ -306,6 +322,9 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     ``on_step``: called with the step count after each communication step (benchmarks).
     """
     own = not isinstance(folder, System)
+    if own:   # refuse ECCO before loading anything
+        _check_algorithm(algorithm or json.loads((Path(folder) / "manifest.json").read_text())["run"]["algorithm"],
+                         folder)
     system = load(folder, parameters) if own else folder
     t = 0.0
     try:
@@ -313,8 +332,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         stop = cfg["stop"] if stop is None else stop
         step = cfg["step"] if step is None else step
         algorithm = algorithm or cfg["algorithm"]
-        if algorithm not in ("jacobi", "gauss-seidel"):
-            raise ValueError(f"unknown algorithm {algorithm!r}")
+        _check_algorithm(algorithm, system.manifest.get("source", "run"))
         n = int(round(stop / step))
         if record is None:
             record = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.outputs()]
