@@ -348,3 +348,24 @@ def test_phase_error_per_period_against_sine(periods_in_substeps, bound):
         body.step(0.05, ZERO6)
     t = 0.05 * n
     assert abs(body.position[0] - 10.0 - np.sin(w * t) / w) * w / 10 <= bound
+
+
+@pytest.mark.parametrize("periods_in_steps", [100, 300, 1000])
+def test_one_rk4_step_when_the_communication_step_is_within_max_substep(periods_in_steps):
+    """dt ≤ max_substep: one classic RK4 step per communication step.  Its amplification
+    factor on the undamped oscillator, R = 1 + z + z²/2 + z³/6 + z⁴/24 at z = −iωdt (q = x + iv/ω
+    obeys q' = −iωq; computed here), gives position and velocity after n steps to round-off; the phase error per period
+    stays within 5 % of RK4's leading term (2π)⁵/(120·N⁴) ≈ 82/N⁴ (N = T/dt)."""
+    dt = 0.05
+    period = periods_in_steps * dt
+    w = 2 * np.pi / period
+    body = surge_body(1e3, 1e3 * w ** 2, 0.0, velocity0=[1.0, 0, 0, 0, 0, 0], max_substep=dt)
+    n = int(round(10 * period / dt))
+    for _ in range(n):
+        body.step(dt, ZERO6)
+    z = -1j * w * dt
+    expected = (1j / w) * (1 + z + z ** 2 / 2 + z ** 3 / 6 + z ** 4 / 24) ** n   # q from i/ω at t = 0
+    np.testing.assert_allclose([body.position[0] - 10.0, body.velocity[0] / w],
+                               [expected.real, expected.imag], rtol=0, atol=1e-9 / w)
+    t = dt * n
+    assert abs(body.position[0] - 10.0 - np.sin(w * t) / w) * w / 10 <= 1.05 * (2 * np.pi) ** 5 / (120 * periods_in_steps ** 4)

@@ -363,7 +363,7 @@ MEMORY_DEFAULTS = {"method": "convolution", "tolerance": 0.01, "memory_length": 
 PRESETS = {
     "screening": {"step": 0.2, "algorithm": "gauss-seidel", "substep": 0.05, "load_hold": "linear",
                   "memory": {"method": "state_space", "tolerance": 0.05, "memory_length": None}},
-    "design": {"step": 0.05, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "linear",
+    "design": {"step": 0.05, "algorithm": "gauss-seidel", "substep": 0.05, "load_hold": "linear",
                "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None}},
     "reference": {"step": 0.01, "algorithm": "gauss-seidel", "substep": 0.005, "load_hold": "linear",
                   "memory": {"method": "convolution", "tolerance": 0.01, "memory_length": None}},

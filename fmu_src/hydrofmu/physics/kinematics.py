@@ -6,15 +6,18 @@ Velocities and accelerations are 6-vectors [linear of the reference point; angul
 both in global axes.  A 6-vector load is [force; moment about the reference point],
 global axes.
 """
+import math
+
 import numpy as np
 
 
 def rotation(attitude):
     """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) for attitude (φ, θ, ψ) [rad]."""
-    phi, theta, psi = attitude
-    cf, sf = np.cos(phi), np.sin(phi)
-    ct, st = np.cos(theta), np.sin(theta)
-    cp, sp = np.cos(psi), np.sin(psi)
+    # plain floats: numpy's per-call cost dominates on three angles
+    phi, theta, psi = attitude.tolist() if isinstance(attitude, np.ndarray) else map(float, attitude)
+    cf, sf = math.cos(phi), math.sin(phi)
+    ct, st = math.cos(theta), math.sin(theta)
+    cp, sp = math.cos(psi), math.sin(psi)
     return np.array([
         [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
         [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
@@ -80,8 +83,8 @@ def point_mass_matrix(mass3, r_global):
 def current_velocity(speed, direction_deg):
     """Global current velocity [m/s] for a speed and a 'going to' direction in degrees,
     counter-clockwise from global +x (horizontal, uniform)."""
-    d = np.radians(direction_deg)
-    return np.array([speed * np.cos(d), speed * np.sin(d), 0.0])
+    d = math.radians(direction_deg)
+    return np.array([speed * math.cos(d), speed * math.sin(d), 0.0])
 
 
 def quad(x):

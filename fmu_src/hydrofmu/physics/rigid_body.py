@@ -48,20 +48,26 @@ Integrator
 ----------
 Butcher's 7-stage Runge–Kutta method of order 6 in equal internal steps of each
 communication step, n = ceil(dt / (5·max_substep)), on the 12 states [η; ν] of every body
-of a group at once.  It replaced classic RK4 in steps of max_substep (20 derivative
-evaluations per 5·max_substep, 7 now).  Measured on an undamped oscillator of period T,
-per period: RK4 ≈ 80/N⁴ (N = T/max_substep), this one ≈ 250/M⁶ with M = N/5 internal
-steps, i.e. 8e-7 against 4e-6 at N = 100, 1e-8 against 5e-9 at N = 300, 8e-11 against
-4e-12 at N = 1000: smaller than RK4's from N ≈ 220, a few times larger at N = 100.
+of a group at once; when the communication step is no longer than max_substep, one
+classic RK4 step instead (4 stages: cheaper, and its error per period, ≈ 82/N⁴ with
+N = T/dt ≥ T/max_substep, is within the RK4-in-substeps bound below).  RK6 replaced
+classic RK4 in steps of max_substep (20 derivative evaluations per 5·max_substep, 7 now).
+Measured on an undamped oscillator of period T, per period: RK4 ≈ 80/N⁴
+(N = T/max_substep), RK6 ≈ 250/M⁶ with M = N/5 internal steps, i.e. 8e-7 against 4e-6 at
+N = 100, 1e-8 against 5e-9 at N = 300, 8e-11 against 4e-12 at N = 1000: smaller than
+RK4's from N ≈ 220, a few times larger at N = 100.
 Each evaluation works on plain floats for the kinematics and the rotating parts of the
 mass matrix, adds them to the constant part (every added-mass block, m·1) and solves once
-for the whole group.  scipy's solve_ivp was measured slower at co-simulation steps (its
-per-call start-up dominates).  Fixed internal steps make the result independent of how
-the master splits time (1 step of 1 s = 10 steps of 0.1 s to round-off when
-5·max_substep divides both).  Accuracy: max_substep ≤ T_min/100 (T_min the shortest
-natural period or decay time) keeps the phase error below ~4e-6 per period.  Explicit
-methods are only stable for ω·h below ~3: very stiff springs or heavy damping need
-max_substep below ~T_min/10.
+for the whole group.  The acceleration is affine in the load, a = (M_rb + A)⁻¹·(rhs + F):
+the matrix and rhs at the end of a step give the published acceleration and, under the
+next step's load, that step's first stage (one evaluation per step saved).  scipy's
+solve_ivp was measured slower at co-simulation steps (its per-call start-up dominates).
+Fixed internal steps make the result independent of how the master splits time (1 step of
+1 s = 10 steps of 0.1 s to round-off when 5·max_substep divides both).  Accuracy:
+max_substep ≤ T_min/100 (T_min the shortest natural period or decay time) keeps the phase
+error below ~4e-6 per period.  Explicit methods are only stable for ω·h below ~3: very
+stiff springs or heavy damping need max_substep below ~T_min/10 (RK6) or steps below
+~0.45·T_min (one RK4 step).
 """
 import math
 
@@ -71,10 +77,11 @@ from ..admissible import inertia as inertia_problems
 from ..errors import InputError
 from .state import Motion
 
-try:   # the gufunc behind np.linalg.solve, without its ~4 µs of wrapping per call
+try:   # the gufunc behind np.linalg.solve, without their ~3 µs of wrapping per call
     from numpy.linalg._umath_linalg import solve1 as _solve
 except ImportError:  # pragma: no cover - other numpy layouts
     _solve = np.linalg.solve
+_sum = np.add.reduce   # ndarray.sum without its Python-level wrapper
 
 GIMBAL_TOL = 1e-6  # |cos θ| below which the Euler-angle rates are declared singular
 
@@ -86,6 +93,10 @@ for _i, _row in enumerate([[], [1 / 3], [0, 2 / 3], [1 / 12, 1 / 3, -1 / 12], [-
                            [0, 9 / 8, -3 / 8, -3 / 4, 1 / 2], [9 / 44, -9 / 11, 63 / 44, 18 / 11, 0, -16 / 11]]):
     RK_A[_i, :_i] = _row
 STEP_RATIO = 5  # internal steps up to STEP_RATIO·max_substep (module docstring)
+# classic RK4: one step when the communication step is no longer than max_substep
+RK4 = (np.array([[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]),
+       np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6]), np.array([0.0, 0.5, 0.5, 1.0]))
+RK6 = (RK_A, RK_B, RK_C)
 
 
 class GimbalLockError(ArithmeticError):
@@ -103,20 +114,22 @@ class _Equations:
     added mass: the one kernel behind RigidBody (n = 1) and CoupledBodies.
 
     State y (12n,) = [η_1; ν_1; η_2; ν_2; …], loads (6n,) = [F_1; M_1; …] (module
-    docstring).  The mass matrix is a constant part (every added-mass block, m·1 of each
-    body) plus the rotating parts of each M_rb, computed on plain floats."""
+    docstring).  Inside ``integrate`` the state is reordered as [η_1; …; η_n; ν_1; …; ν_n],
+    so a derivative is [kinematic rates; accelerations] in two slices.  The mass matrix is a
+    constant part (every added-mass block, m·1 of each body) plus the rotating parts of
+    each M_rb, computed on plain floats."""
 
     def __init__(self, bodies, cross=None):
-        n = len(bodies)
+        n = self.n = len(bodies)
         self.const = np.zeros((6 * n, 6 * n))
-        self.kd = np.zeros((6 * n, 12 * n))     # [K | D] per body: K·η + D·ν = kd·y
+        kd = np.zeros((6 * n, 12 * n))     # [K | D] per body: K·η + D·ν = kd·y
         self.k_eta0 = np.zeros(6 * n)
         self.props, block_idx = [], []
         for i, b in enumerate(bodies):
             s = slice(6 * i, 6 * i + 6)
             self.const[s, s] = b.added_mass
             self.const[s, s][:3, :3] += b.mass * np.eye(3)
-            self.kd[s, 12 * i:12 * i + 6], self.kd[s, 12 * i + 6:12 * i + 12] = b.stiffness, b.damping
+            kd[s, 12 * i:12 * i + 6], kd[s, 12 * i + 6:12 * i + 12] = b.stiffness, b.damping
             self.k_eta0[s] = b.stiffness @ b.eta0
             cog = tuple(b.cog.tolist()) if np.any(b.cog) else None
             io = b.inertia + b.mass * (b.cog @ b.cog * np.eye(3) - np.outer(b.cog, b.cog))
@@ -128,22 +141,31 @@ class _Equations:
         for (i, j), m in (cross or {}).items():
             self.const[6 * i:6 * i + 6, 6 * j:6 * j + 6] += m
         self.block_idx = np.concatenate(block_idx)
+        # the constant part under the rotating blocks, added to them on floats
+        self.block_const = self.const.reshape(-1)[self.block_idx].tolist()
         idx = np.arange(12 * n).reshape(n, 2, 6)
-        self.kin_idx, self.acc_idx = idx[:, 0].ravel(), idx[:, 1].ravel()
+        self.order = np.concatenate([idx[:, 0].ravel(), idx[:, 1].ravel()])   # y[order]: [η…; ν…]
+        self.back = np.argsort(self.order)
+        self.kd = kd[:, self.order]
         self.first = bodies[0]   # names the body in a singular-matrix error
+        self._tables = {}
 
-    def system(self, y, load, signs=None):
-        """(M_rb + A, right-hand side, kinematic rates [ẋ; φ̇, θ̇, ψ̇] per body as floats) at y.
-        ``signs``: sign of cos θ of each body at the start of the step (default: now); a
-        cos θ below GIMBAL_TOL on that side raises GimbalLockError."""
-        yl = y.tolist()
+    def parts(self, yl, signs=None):
+        """Rotating mass-matrix entries (constant part included, at ``block_idx``), bias
+        b and kinematic rates [ẋ; φ̇, θ̇, ψ̇] of every body, as floats, at the reordered state
+        ``yl`` (a list).  ``signs``: sign of cos θ of each body at the start of the step
+        (default: now); a cos θ below GIMBAL_TOL on that side raises GimbalLockError."""
+        n6 = 6 * self.n
         kin, bias, blocks = [], [], []
+        c = self.block_const
+        at = 0
         for i, (m, cog, io_b) in enumerate(self.props):
-            _, _, _, phi, theta, psi, vx, vy, vz, wx, wy, wz = yl[12 * i:12 * i + 12]
+            phi, theta, psi = yl[6 * i + 3:6 * i + 6]
+            vx, vy, vz, wx, wy, wz = yl[n6 + 6 * i:n6 + 6 * i + 6]
             cf, sf, ct, st, cp, sp = (math.cos(phi), math.sin(phi), math.cos(theta), math.sin(theta),
                                       math.cos(psi), math.sin(psi))
             if ct * (signs[i] if signs else (1.0 if ct > 0.0 else -1.0)) < GIMBAL_TOL:
-                raise GimbalLockError(_gimbal_message(y[12 * i + 3:12 * i + 6]))
+                raise GimbalLockError(_gimbal_message(np.array([phi, theta, psi])))
             # R = Rz(ψ)·Ry(θ)·Rx(φ); Euler rates solving ω = T·[φ̇, θ̇, ψ̇]
             r00, r01, r02 = cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf
             r10, r11, r12 = sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf
@@ -158,7 +180,9 @@ class _Equations:
             i00, i01, i02 = p00 * r00 + p01 * r01 + p02 * r02, p00 * r10 + p01 * r11 + p02 * r12, p00 * r20 + p01 * r21 + p02 * r22
             i11, i12 = p10 * r10 + p11 * r11 + p12 * r12, p10 * r20 + p11 * r21 + p12 * r22
             i22 = p20 * r20 + p21 * r21 + p22 * r22
-            blocks += (i00, i01, i02, i01, i11, i12, i02, i12, i22)
+            blocks += (c[at] + i00, c[at + 1] + i01, c[at + 2] + i02, c[at + 3] + i01, c[at + 4] + i11,
+                       c[at + 5] + i12, c[at + 6] + i02, c[at + 7] + i12, c[at + 8] + i22)
+            at += 9
             hx, hy, hz = i00 * wx + i01 * wy + i02 * wz, i01 * wx + i11 * wy + i12 * wz, i02 * wx + i12 * wy + i22 * wz
             gyro = (wy * hz - wz * hy, wz * hx - wx * hz, wx * hy - wy * hx)
             if cog is None:
@@ -168,56 +192,104 @@ class _Equations:
             rx, ry, rz = (r00 * cx + r01 * cy + r02 * cz, r10 * cx + r11 * cy + r12 * cz,
                           r20 * cx + r21 * cy + r22 * cz)
             mx, my, mz = m * rx, m * ry, m * rz
-            blocks += (0.0, -mz, my, mz, 0.0, -mx, -my, mx, 0.0)   # m·[r]× below, −m·[r]× above
-            blocks += (0.0, mz, -my, -mz, 0.0, mx, my, -mx, 0.0)
+            # m·[r]× below, −m·[r]× above
+            blocks += [k + v for k, v in zip(c[at:at + 18], (0.0, -mz, my, mz, 0.0, -mx, -my, mx, 0.0,
+                                                               0.0, mz, -my, -mz, 0.0, mx, my, -mx, 0.0))]
+            at += 18
             ux, uy, uz = wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx          # ω × r
             bias += (m * (wy * uz - wz * uy), m * (wz * ux - wx * uz), m * (wx * uy - wy * ux)) + gyro
+        return blocks, bias, kin
+
+    def matrix(self, blocks):
         big = self.const.copy()
-        big.reshape(-1)[self.block_idx] += blocks
-        rhs = load + self.k_eta0 - self.kd @ y
+        big.put(self.block_idx, blocks)
+        return big
+
+    def check(self, big):
+        """Raise the InputError of a singular (finite) mass matrix M_rb + A."""
+        if np.isfinite(big).all():
+            try:
+                np.linalg.inv(big)
+            except np.linalg.LinAlgError:
+                raise self.first._error("added_mass", "mass matrix M_rb + A is singular") from None
+
+    def start(self, yp, signs=None):
+        """What a step needs at the reordered state yp, whatever the load: (kinematic
+        rates, M_rb + A, right-hand side without the load).  The acceleration under a load
+        L is then (M_rb + A)⁻¹·(rhs + L): the published acceleration of one step and the
+        first stage of the next one share it."""
+        blocks, bias, kin = self.parts(yp.tolist(), signs)
+        rhs = self.k_eta0 - self.kd @ yp
         rhs -= bias
-        return big, rhs, kin
+        return kin, self.matrix(blocks), rhs
 
-    def solve(self, big, rhs):
-        """(M_rb + A)⁻¹·rhs; a singular mass matrix is an InputError."""
+    def accelerations(self, y, load, start=None):
+        """[a; α] of every body (6n,) at state y under ``load`` (``start``: ``self.start``
+        of y, if known)."""
+        _, big, rhs = start or self.start(y[self.order])
         with np.errstate(all="ignore"):
-            acc = _solve(big, rhs)
-        if math.isfinite(acc.sum()):
-            return acc
-        try:   # not finite: np.linalg.solve tells a singular matrix from a non-finite input
-            return np.linalg.solve(big, rhs)
-        except np.linalg.LinAlgError:
-            raise self.first._error("added_mass", "mass matrix M_rb + A is singular") from None
+            acc = _solve(big, rhs + load)
+        if not math.isfinite(_sum(acc)):
+            self.check(big)
+        return acc
 
-    def accelerations(self, y, load, signs=None):
-        big, rhs, _ = self.system(y, load, signs)
-        return self.solve(big, rhs)
+    def table(self, h, method):
+        """RK coefficients of ``method`` (RK4 or RK6) for an internal step h: rows
+        [1, h·a_s] per stage and [1, h·b]."""
+        t = self._tables.get((h, len(method[1])))
+        if t is None:
+            ra, rb, _ = method
+            a = np.zeros((len(rb), len(rb) + 1))
+            a[:, 0], a[:, 1:] = 1.0, h * ra
+            b = np.concatenate([[1.0], h * rb])
+            t = self._tables[(h, len(rb))] = (a, b)
+            if len(self._tables) > 8:
+                self._tables.pop(next(iter(self._tables)))
+        return t
 
-    def deriv(self, y, load, signs):
-        big, rhs, kin = self.system(y, load, signs)
-        out = np.empty(y.size)
-        out[self.kin_idx] = kin
-        out[self.acc_idx] = self.solve(big, rhs)
-        return out
-
-    def integrate(self, y, load, rate, dt, max_substep):
-        """State after dt [s] > 0 from y under load + rate·t (rate None: held load)."""
-        n = max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))  # 1e-12: round-off
+    def integrate(self, y, load, rate, dt, max_substep, start=None, checked=False):
+        """(state after dt [s] > 0 from y under load + rate·t (rate None: held load), and
+        ``start`` of that state).  ``start``: ``self.start`` of y, if known.  A result that
+        is not finite is computed again ``checked``: a singular matrix raises InputError."""
+        if dt <= max_substep * (1.0 + 1e-12):   # 1e-12: round-off
+            method, n = RK4, 1
+        else:
+            method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
         h = dt / n
-        signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in y[4::12].tolist()]
-        k = np.zeros((7, y.size))    # rows past a stage meet zeros of RK_A: never garbage
-        ha, hb = h * RK_A, h * RK_B
-        f = self.deriv
+        n6 = 6 * self.n
+        yp = y[self.order]
+        signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in yp[4:n6:6].tolist()]
+        a, b = self.table(h, method)
+        nodes, ns = method[2], len(method[1])
+        kd, parts, matrix, first = self.kd, self.parts, self.matrix, start
+        # (no np.errstate here: ~1.5 µs a step; a non-finite result is checked below)
+        stages = np.zeros((ns + 1, 2 * n6))    # [y; k_1 … k_s]; rows past a stage meet zeros of a
+        base = load + self.k_eta0
         for m in range(n):
-            loads = [load] * 7 if rate is None else load + np.outer((m + RK_C) * h, rate)
-            k[0] = f(y, loads[0], signs)
-            for s in range(1, 7):
-                k[s] = f(y + ha[s] @ k, loads[s], signs)
-            y = y + hb @ k
-        for i, ct in enumerate(np.cos(y[4::12]).tolist()):
-            if abs(ct) < GIMBAL_TOL:
-                raise GimbalLockError(_gimbal_message(y[12 * i + 3:12 * i + 6]))
-        return y
+            if rate is None:
+                l0, forcing = load, [base] * ns
+            else:
+                l0, forcing = load + (m * h) * rate, base + np.outer((m + nodes) * h, rate)
+            kin, big, rhs = start or self.start(yp, signs)
+            stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big, rhs + l0)
+            for s in range(1, ns):
+                ys = a[s] @ stages
+                blocks, bias, kin = parts(ys.tolist(), signs)
+                rhs = forcing[s] - kd @ ys
+                rhs -= bias
+                big = matrix(blocks)
+                acc = stages[s + 1, n6:] = _solve(big, rhs)
+                stages[s + 1, :n6] = kin
+                if checked and not math.isfinite(_sum(acc)):
+                    self.check(big)
+            yp = b @ stages
+            start = None
+        if not math.isfinite(_sum(yp)):   # a singular matrix, or non-finite loads
+            if not checked:
+                with np.errstate(all="ignore"):
+                    return self.integrate(y, load, rate, dt, max_substep, first, checked=True)
+            return yp[self.back], None
+        return yp[self.back], self.start(yp)   # (start checks |cos θ| at the end of the step)
 
 
 class RigidBody:
@@ -257,7 +329,8 @@ class RigidBody:
     def mass_matrix(self):
         """Total 6×6 mass matrix M_rb + A about the reference point, global axes, at the
         current attitude [kg, kg·m, kg·m²]."""
-        return self._eq.system(self._y, np.zeros(6))[0]
+        eq = self._eq
+        return eq.matrix(eq.parts(self._y[eq.order].tolist())[0])
 
     @property
     def added_mass(self):
@@ -269,6 +342,7 @@ class RigidBody:
     def added_mass(self, value):
         self._added_mass = self._array(value, (6, 6), "added_mass")
         self._eq = _Equations([self])
+        self._end = None   # (state, _Equations.start of it) after a step
 
     # -- input checks -------------------------------------------------------------------
     def _error(self, field, message):
@@ -308,10 +382,16 @@ class RigidBody:
         y = self._y
         if dt > 0.0:
             rate = None if load_rate is None else np.asarray(load_rate, dtype=float)
-            y = self._eq.integrate(y, load, rate, dt, self.max_substep)
+            y, end = self._eq.integrate(y, load, rate, dt, self.max_substep, self._start())
+            self._end = (y, end)
             if rate is not None:
                 load = load + rate * dt
         self._y, self._load = y, load
+
+    def _start(self):
+        """_Equations.start of the current state if the last step left it, else None."""
+        end = self._end
+        return end[1] if end is not None and end[0] is self._y else None
 
     # -- outputs ------------------------------------------------------------------------
     @property
@@ -333,7 +413,7 @@ class RigidBody:
     def acceleration(self):
         """[a; α] [m/s², rad/s²], global axes, from the current state and the load of the
         last step (zero before the first step)."""
-        return self._eq.accelerations(self._y, self._load)
+        return self._eq.accelerations(self._y, self._load, self._start())
 
     def motion(self):
         """The current motion as a state.Motion (what load kernels take as input)."""
@@ -366,6 +446,7 @@ class CoupledBodies:
         self.cross = {k: np.asarray(v, dtype=float) for k, v in cross.items()}
         self.max_substep = min(b.max_substep for b in self.bodies)
         self._eq = _Equations(self.bodies, self.cross)
+        self._end = None   # (the bodies' states, _Equations.start of them) after a step
 
     def step(self, dt, loads, rates=None):
         """Advance all bodies by dt [s] with their external loads (list of (6,)) held, or
@@ -374,13 +455,23 @@ class CoupledBodies:
         y = np.concatenate([b._y for b in self.bodies])
         if dt > 0.0:
             rates = None if rates is None else np.array(rates, dtype=float).ravel()
-            y = self._eq.integrate(y, loads, rates, dt, self.max_substep)
+            y, end = self._eq.integrate(y, loads, rates, dt, self.max_substep, self._start())
             if rates is not None:
                 loads = loads + rates * dt
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
+        if dt > 0.0:
+            self._end = ([b._y for b in self.bodies], end)
+
+    def _start(self):
+        """_Equations.start of the bodies' states if the last step left them, else None."""
+        end = self._end
+        if end is not None and all(y is b._y for y, b in zip(end[0], self.bodies)):
+            return end[1]
+        return None
 
     def accelerations(self):
         """(n, 6) accelerations from the current states and the last held loads."""
         y = np.concatenate([b._y for b in self.bodies])
-        return self._eq.accelerations(y, np.concatenate([b._load for b in self.bodies])).reshape(-1, 6)
+        return self._eq.accelerations(y, np.concatenate([b._load for b in self.bodies]),
+                                      self._start()).reshape(-1, 6)
