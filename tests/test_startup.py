@@ -24,7 +24,8 @@ sys.path.insert(0, sys.argv[1])
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 md = read_model_description(sys.argv[2])
-s = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[2]), instanceName="x",
+unzipped = extract(sys.argv[2])
+s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, instanceName="x",
               modelIdentifier=md.coSimulation.modelIdentifier)
 s.instantiate()
 s.setupExperiment(startTime=0.0)
@@ -34,8 +35,11 @@ s.doStep(0.0, 0.05)
 s.terminate()
 s.freeInstance()
 print("pythonfmu.builder" in sys.modules, "argparse" in sys.modules)
+import shutil
+shutil.rmtree(unzipped)   # as fmpy and hydrofmu's master do after use
 from pythonfmu import FmuBuilder   # the rest of pythonfmu still loads on first use
-print("pythonfmu.builder" in sys.modules)
+from pythonfmu.builder import FmuBuilder as same
+print("pythonfmu.builder" in sys.modules and FmuBuilder is same)
 print("scipy" in sys.modules)
 """
 

@@ -34,21 +34,31 @@ def _light_pythonfmu():
     """Let the slave import pythonfmu's slave API without pythonfmu's package __init__,
     which imports its FMU builder (argparse, zipfile, shutil, xml.dom…: ~25 ms of the
     ~35 ms import, paid by every host that starts an FMU).  Unless pythonfmu is loaded
-    already, the package module goes into sys.modules unexecuted (its __path__ set, so
-    its submodules import as usual); the first use of anything else (``pythonfmu.
-    FmuBuilder``…) runs the real __init__ in it (PEP 562 module __getattr__)."""
+    already, the package module goes into sys.modules unexecuted, its __path__ set so that
+    its submodules import as usual; the first use of anything else (``pythonfmu.
+    FmuBuilder``…) runs the real __init__ in it (PEP 562 module __getattr__).  __path__
+    lists every copy on sys.path, the first found first: the FMU's own copy lives in its
+    extracted folder, which a host may delete after use (fmpy, hydrofmu's master)."""
+    import importlib.machinery
     import importlib.util
     if "pythonfmu" in sys.modules:
         return
     spec = importlib.util.find_spec("pythonfmu")
     if spec is None or spec.loader is None or not spec.submodule_search_locations:
         return
+    copies = [os.path.join(p, "pythonfmu") for p in sys.path if isinstance(p, str)]
+    copies = [p for p in copies if os.path.isfile(os.path.join(p, "__init__.py"))]
     pkg = importlib.util.module_from_spec(spec)
+    pkg.__path__ = list(dict.fromkeys(list(spec.submodule_search_locations) + copies))
 
     def rest(name):
         del pkg.__dict__["__getattr__"]
-        spec.loader.exec_module(pkg)
-        return getattr(pkg, name)
+        for folder in pkg.__path__:
+            init = os.path.join(folder, "__init__.py")
+            if os.path.isfile(init):
+                importlib.machinery.SourceFileLoader("pythonfmu", init).exec_module(pkg)
+                return getattr(pkg, name)
+        raise AttributeError(f"module 'pythonfmu' has no attribute {name!r} (no copy of pythonfmu left)")
 
     pkg.__getattr__ = rest
     sys.modules["pythonfmu"] = pkg
@@ -68,7 +78,12 @@ from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
-_sum = np.add.reduce   # ndarray.sum without its Python-level wrapper
+
+
+def _finite(values):
+    """True if the sum of a short list of floats is finite (all are, barring an overflow of
+    the sum; callers then look closer).  On a list: numpy's reductions cost ~2 µs a call."""
+    return math.isfinite(sum(values))
 LIN_ROT = {
     "velocity": ["m/s"] * 3 + ["rad/s"] * 3,
     "acceleration": ["m/s2"] * 3 + ["rad/s2"] * 3,
@@ -275,10 +290,10 @@ class ArraySlave(Fmi2Slave):
         if self.error is not None:   # kept: the next fmi2DoStep fails on it too
             self.fail(self.error)
             return self.values[vrs].tolist()
-        out = self.values[vrs]
-        if not math.isfinite(_sum(out)):
+        out = self.values[vrs].tolist()
+        if not _finite(out):
             self.check_outputs(vrs)
-        return out.tolist()
+        return out
 
     @guarded()
     def set_real(self, vrs, values):
@@ -298,7 +313,7 @@ class ArraySlave(Fmi2Slave):
         output); True when all are finite."""
         vrs = self.output_vrs if vrs is None else vrs
         out = self.values[vrs]
-        if math.isfinite(_sum(out)):
+        if _finite(out.tolist()) or np.isfinite(out).all():
             return True
         var = self.vars[int(np.asarray(vrs)[np.argmin(np.isfinite(out))])]
         self.fail(f"{var.causality.name} {var.name} = {self.values[var.value_reference]} is not finite")
@@ -337,7 +352,7 @@ class ArraySlave(Fmi2Slave):
         else:
             idx = np.r_[tuple(slices)] if slices else np.zeros(0, int)
             self._finite_idx[id(slices)] = (slices, idx)
-        if math.isfinite(_sum(self.values[idx])):   # one sum; the search below only on failure
+        if _finite(self.values[idx].tolist()):   # one sum; the search below only on failure
             return True
         for s in slices:
             block = self.values[s]
@@ -455,6 +470,7 @@ class LoadSlave(ArraySlave):
         self.inputs = inputs
         # every load output in one block: total, each effect, each coupling
         self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings])]
+        self._load_total = np.r_[0.0, np.ones(len(self.effect_force) + len(self.couplings))]   # their sum
         # export mode: the mass contribution of acceleration loads, for the dynamics side
         if self.loads.uses_acceleration and not explicit:
             self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
@@ -487,7 +503,7 @@ class LoadSlave(ArraySlave):
                 out[k] = c["memory"].force(v[c["velocity"]])
             if c["acceleration"] is not None:
                 out[k] -= c["mass"] @ v[c["acceleration"]]
-        out[0] = out[1:].sum(axis=0)
+        out[0] = self._load_total @ out
         v[self._load_out] = out.ravel()
 
     def step_physics(self, t, dt):

@@ -190,10 +190,13 @@ class CurrentPolar:
 
     def coefficients(self, alpha):
         """(CXC, CYC, CMZC) at incidence ``alpha`` [deg] in [0, 360), linear with wrap-around."""
+        return np.array(self._coefficients(alpha))
+
+    def _coefficients(self, alpha):
         angles, coef, slope = self._rows
         i = bisect.bisect_right(angles, alpha) - 1
         d = alpha - angles[i]
-        return np.array([c + d * s for c, s in zip(coef[i], slope[i])])
+        return [c + d * s for c, s in zip(coef[i], slope[i])]
 
     def load(self, motion, env):
         """[force N; moment N·m about the reference point], global axes."""
@@ -209,7 +212,8 @@ class CurrentPolar:
         alpha = math.degrees(math.atan2(by, bx)) % 360.0 if v2 > 0.0 else 0.0
         if alpha >= 360.0:  # -tiny % 360 rounds to 360
             alpha = 0.0
-        c0, c1, c2 = (self.coefficients(alpha) * (0.5 * env.rho * self.surfc * v2)).tolist()
+        q = 0.5 * env.rho * self.surfc * v2
+        c0, c1, c2 = (q * c for c in self._coefficients(alpha))
         fx, fy, fz = r00 * c0 + r01 * c1, r10 * c0 + r11 * c1, r20 * c0 + r21 * c1
         return np.array((fx, fy, fz, ry * fz - rz * fy + r02 * c2, rz * fx - rx * fz + r12 * c2,
                          rx * fy - ry * fx + r22 * c2))

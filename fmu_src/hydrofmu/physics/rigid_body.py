@@ -227,8 +227,7 @@ class _Equations:
         """[a; α] of every body (6n,) at state y under ``load`` (``start``: ``self.start``
         of y, if known)."""
         _, big, rhs = start or self.start(y[self.order])
-        with np.errstate(all="ignore"):
-            acc = _solve(big, rhs + load)
+        acc = _solve(big, rhs + load)
         if not math.isfinite(_sum(acc)):
             self.check(big)
         return acc
@@ -452,26 +451,31 @@ class CoupledBodies:
         """Advance all bodies by dt [s] with their external loads (list of (6,)) held, or
         varying linearly at ``rates`` from their values at the start of the step."""
         loads = np.array(loads, dtype=float).ravel()
-        y = np.concatenate([b._y for b in self.bodies])
+        last = self._last()
+        y = last[0] if last else np.concatenate([b._y for b in self.bodies])
+        end = last[2] if last else None
         if dt > 0.0:
             rates = None if rates is None else np.array(rates, dtype=float).ravel()
-            y, end = self._eq.integrate(y, loads, rates, dt, self.max_substep, self._start())
+            y, end = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
             if rates is not None:
                 loads = loads + rates * dt
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
-        if dt > 0.0:
-            self._end = ([b._y for b in self.bodies], end)
+        self._end = ([b._y for b in self.bodies] + [b._load for b in self.bodies], y, loads, end)
 
-    def _start(self):
-        """_Equations.start of the bodies' states if the last step left them, else None."""
+    def _last(self):
+        """(state, loads, _Equations.start of the state or None) of all bodies as the last
+        step left them, while the bodies still hold them; else None."""
         end = self._end
-        if end is not None and all(y is b._y for y, b in zip(end[0], self.bodies)):
-            return end[1]
+        if end is not None and all(a is b for a, b in zip(end[0], [b._y for b in self.bodies]
+                                                          + [b._load for b in self.bodies])):
+            return end[1:]
         return None
 
     def accelerations(self):
         """(n, 6) accelerations from the current states and the last held loads."""
+        last = self._last()
+        if last:
+            return self._eq.accelerations(last[0], last[1], last[2]).reshape(-1, 6)
         y = np.concatenate([b._y for b in self.bodies])
-        return self._eq.accelerations(y, np.concatenate([b._load for b in self.bodies]),
-                                      self._start()).reshape(-1, 6)
+        return self._eq.accelerations(y, np.concatenate([b._load for b in self.bodies])).reshape(-1, 6)
