@@ -369,3 +369,15 @@ def test_one_rk4_step_when_the_communication_step_is_within_max_substep(periods_
                                [expected.real, expected.imag], rtol=0, atol=1e-9 / w)
     t = dt * n
     assert abs(body.position[0] - 10.0 - np.sin(w * t) / w) * w / 10 <= 1.05 * (2 * np.pi) ** 5 / (120 * periods_in_steps ** 4)
+
+
+def test_singular_mass_matrix_is_an_input_error():
+    """M_rb + A singular (an added mass of −m in surge): the step and the acceleration name
+    the added mass, whatever path found it (the published acceleration, a stage)."""
+    added = np.zeros((6, 6))
+    added[0, 0] = -1e3
+    body = RigidBody(1e3, np.eye(3), added_mass=added, source="scene.toml:bodies.b")
+    for call in (lambda: body.acceleration, lambda: body.step(0.1, ZERO6)):
+        with pytest.raises(InputError, match="singular") as err:
+            call()
+        assert err.value.field == "added_mass" and err.value.path == "scene.toml:bodies.b"

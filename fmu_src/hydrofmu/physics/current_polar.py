@@ -189,10 +189,8 @@ class CurrentPolar:
         return cls(name or data.name, angles, cx, cy, cmz, data.xc, data.yc, data.zc, data.surfc)
 
     def coefficients(self, alpha):
-        """(CXC, CYC, CMZC) at incidence ``alpha`` [deg] in [0, 360), linear with wrap-around."""
-        return np.array(self._coefficients(alpha))
-
-    def _coefficients(self, alpha):
+        """[CXC, CYC, CMZC] (floats) at incidence ``alpha`` [deg] in [0, 360), linear with
+        wrap-around."""
         angles, coef, slope = self._rows
         i = bisect.bisect_right(angles, alpha) - 1
         d = alpha - angles[i]
@@ -213,7 +211,7 @@ class CurrentPolar:
         if alpha >= 360.0:  # -tiny % 360 rounds to 360
             alpha = 0.0
         q = 0.5 * env.rho * self.surfc * v2
-        c0, c1, c2 = (q * c for c in self._coefficients(alpha))
+        c0, c1, c2 = (q * c for c in self.coefficients(alpha))
         fx, fy, fz = r00 * c0 + r01 * c1, r10 * c0 + r11 * c1, r20 * c0 + r21 * c1
         return np.array((fx, fy, fz, ry * fz - rz * fy + r02 * c2, rz * fx - rx * fz + r12 * c2,
                          rx * fy - ry * fx + r22 * c2))

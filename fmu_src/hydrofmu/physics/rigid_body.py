@@ -75,6 +75,7 @@ import numpy as np
 
 from ..admissible import inertia as inertia_problems
 from ..errors import InputError
+from . import quiet
 from .state import Motion
 
 try:   # the gufunc behind np.linalg.solve, without their ~3 µs of wrapping per call
@@ -174,9 +175,17 @@ class _Equations:
             kin += (vx, vy, vz, phi_dot, -sp * wx + cp * wy, wz + st * phi_dot)
             # inertia about O in global axes, R·I_O·Rᵀ (symmetric), and ω × (I_O·ω)
             a00, a01, a02, a11, a12, a22 = io_b
-            p00, p01, p02 = r00 * a00 + r01 * a01 + r02 * a02, r00 * a01 + r01 * a11 + r02 * a12, r00 * a02 + r01 * a12 + r02 * a22
-            p10, p11, p12 = r10 * a00 + r11 * a01 + r12 * a02, r10 * a01 + r11 * a11 + r12 * a12, r10 * a02 + r11 * a12 + r12 * a22
-            p20, p21, p22 = r20 * a00 + r21 * a01 + r22 * a02, r20 * a01 + r21 * a11 + r22 * a12, r20 * a02 + r21 * a12 + r22 * a22
+            if a01 == a02 == a12 == 0.0:   # principal axes (most bodies): R·I_O on the diagonal only
+                p00, p01, p02 = r00 * a00, r01 * a11, r02 * a22
+                p10, p11, p12 = r10 * a00, r11 * a11, r12 * a22
+                p20, p21, p22 = r20 * a00, r21 * a11, r22 * a22
+            else:
+                p00, p01, p02 = (r00 * a00 + r01 * a01 + r02 * a02, r00 * a01 + r01 * a11 + r02 * a12,
+                                 r00 * a02 + r01 * a12 + r02 * a22)
+                p10, p11, p12 = (r10 * a00 + r11 * a01 + r12 * a02, r10 * a01 + r11 * a11 + r12 * a12,
+                                 r10 * a02 + r11 * a12 + r12 * a22)
+                p20, p21, p22 = (r20 * a00 + r21 * a01 + r22 * a02, r20 * a01 + r21 * a11 + r22 * a12,
+                                 r20 * a02 + r21 * a12 + r22 * a22)
             i00, i01, i02 = p00 * r00 + p01 * r01 + p02 * r02, p00 * r10 + p01 * r11 + p02 * r12, p00 * r20 + p01 * r21 + p02 * r22
             i11, i12 = p10 * r10 + p11 * r11 + p12 * r12, p10 * r20 + p11 * r21 + p12 * r22
             i22 = p20 * r20 + p21 * r21 + p22 * r22
@@ -227,7 +236,11 @@ class _Equations:
         """[a; α] of every body (6n,) at state y under ``load`` (``start``: ``self.start``
         of y, if known)."""
         _, big, rhs = start or self.start(y[self.order])
-        acc = _solve(big, rhs + load)
+        token = quiet.off()
+        try:
+            acc = _solve(big, rhs + load)
+        finally:
+            quiet.restore(token)
         if not math.isfinite(_sum(acc)):
             self.check(big)
         return acc
@@ -254,14 +267,26 @@ class _Equations:
             method, n = RK4, 1
         else:
             method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
-        h = dt / n
-        n6 = 6 * self.n
         yp = y[self.order]
-        signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in yp[4:n6:6].tolist()]
+        signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in yp[4:6 * self.n:6].tolist()]
+        token = quiet.off()   # a non-finite result is checked below
+        try:
+            yp = self._steps(yp, load, rate, dt / n, n, start, signs, method, checked)
+        finally:
+            quiet.restore(token)
+        if not math.isfinite(_sum(yp)):   # a singular matrix, or non-finite loads
+            if not checked:
+                return self.integrate(y, load, rate, dt, max_substep, start, checked=True)
+            return yp[self.back], None
+        return yp[self.back], self.start(yp)   # (start checks |cos θ| at the end of the step)
+
+    def _steps(self, yp, load, rate, h, n, start, signs, method, checked):
+        """n internal steps h of ``method`` from the reordered state yp (integrate)."""
+        n6 = 6 * self.n
         a, b = self.table(h, method)
         nodes, ns = method[2], len(method[1])
-        kd, parts, matrix, first = self.kd, self.parts, self.matrix, start
-        # (no np.errstate here: ~1.5 µs a step; a non-finite result is checked below)
+        kd, parts, idx = self.kd, self.parts, self.block_idx
+        big = self.const.copy()   # the stages' mass matrix (its rotating entries put anew in each)
         stages = np.zeros((ns + 1, 2 * n6))    # [y; k_1 … k_s]; rows past a stage meet zeros of a
         base = load + self.k_eta0
         for m in range(n):
@@ -269,26 +294,23 @@ class _Equations:
                 l0, forcing = load, [base] * ns
             else:
                 l0, forcing = load + (m * h) * rate, base + np.outer((m + nodes) * h, rate)
-            kin, big, rhs = start or self.start(yp, signs)
-            stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big, rhs + l0)
+            kin, big0, rhs = start or self.start(yp, signs)
+            stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big0, rhs + l0)
+            if checked and not math.isfinite(_sum(stages[1])):
+                self.check(big0)
             for s in range(1, ns):
                 ys = a[s] @ stages
                 blocks, bias, kin = parts(ys.tolist(), signs)
                 rhs = forcing[s] - kd @ ys
                 rhs -= bias
-                big = matrix(blocks)
+                big.put(idx, blocks)
                 acc = stages[s + 1, n6:] = _solve(big, rhs)
                 stages[s + 1, :n6] = kin
                 if checked and not math.isfinite(_sum(acc)):
                     self.check(big)
             yp = b @ stages
             start = None
-        if not math.isfinite(_sum(yp)):   # a singular matrix, or non-finite loads
-            if not checked:
-                with np.errstate(all="ignore"):
-                    return self.integrate(y, load, rate, dt, max_substep, first, checked=True)
-            return yp[self.back], None
-        return yp[self.back], self.start(yp)   # (start checks |cos θ| at the end of the step)
+        return yp
 
 
 class RigidBody:
