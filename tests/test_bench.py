@@ -105,6 +105,24 @@ def test_floor_fmu_copies_its_inputs(tmp_path):
     folder = floor.floor_system(tmp_path, fmu, 3)
     assert floor.fmu_count(folder) == 3
     assert floor.per_step(folder, 20, 0.05) > 0 and floor.startup(folder) > 0
+    # other sizes (bench.overhead's floor under a load FMU's calls): y_i = u_(i mod n_in)
+    fmu = floor.build_floor(tmp_path / "sized", 4, 2)
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    assert sorted(vr) == ["u[1]", "u[2]", "u[3]", "u[4]", "y[1]", "y[2]"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="g")
+    slave.instantiate()
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        slave.setReal([vr[f"u[{i}]"] for i in range(1, 5)], [1.0, 2.0, 3.0, 4.0])
+        slave.doStep(0.0, 0.05)
+        assert slave.getReal([vr["y[1]"], vr["y[2]"]]) == [1.0, 2.0]
+    finally:
+        slave.terminate()
+        slave.freeInstance()
 
 
 def test_floor_spread_and_linearity_bookkeeping():

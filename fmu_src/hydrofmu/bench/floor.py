@@ -1,7 +1,8 @@
 """FMU figures against the pythonfmu floor: startup and cost per step of whole scenes.
 
 The floor is what an FMU built with pythonfmu cannot beat: a trivial pythonfmu FMU (6 inputs,
-6 outputs, ``do_step`` copies the inputs to the outputs), built on the fly.  For a scene of
+6 outputs, ``do_step`` copies the inputs to the outputs; other sizes for ``bench.overhead``),
+built on the fly.  For a scene of
 n FMUs, the floor is n of them connected in a ring and run by the same master
 (``cosim.master``, Gauss–Seidel, every output recorded), so every figure below is a multiple
 of what the same master pays for the same number of FMUs that do nothing:
@@ -27,26 +28,27 @@ import numpy as np
 
 NOISY = 0.25   # spread between rounds above which a figure is not trusted
 
-FLOOR_SCRIPT = '''"""The pythonfmu floor: 6 inputs copied to 6 outputs at every step."""
+FLOOR_SCRIPT = '''"""The pythonfmu floor: {n_in} inputs, {n_out} outputs, do_step copies inputs to outputs."""
 from pythonfmu import Fmi2Causality, Fmi2Slave, Real
 
 
-class hydrofmu_floor(Fmi2Slave):
+class {name}(Fmi2Slave):
     author = "hydrofmu bench"
     description = "trivial FMU: do_step copies u to y"
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.u, self.y = [0.0] * 6, [0.0] * 6
-        for i in range(6):
-            self.register_variable(Real(f"u[{i + 1}]", causality=Fmi2Causality.input,
+        self.u, self.y = [0.0] * {n_in}, [0.0] * {n_out}
+        for i in range({n_in}):
+            self.register_variable(Real(f"u[{{i + 1}}]", causality=Fmi2Causality.input,
                                         getter=lambda i=i: self.u[i],
                                         setter=lambda v, i=i: self.u.__setitem__(i, v)))
-            self.register_variable(Real(f"y[{i + 1}]", causality=Fmi2Causality.output,
+        for i in range({n_out}):
+            self.register_variable(Real(f"y[{{i + 1}}]", causality=Fmi2Causality.output,
                                         getter=lambda i=i: self.y[i]))
 
     def do_step(self, current_time, step_size):
-        self.y[:] = self.u
+        self.y[:] = (self.u * {n_out})[:{n_out}]
         return True
 '''
 
@@ -62,14 +64,15 @@ print(json.dumps(t1 - t0))
 '''
 
 
-def build_floor(folder):
-    """Build the trivial FMU into ``folder``; returns its path."""
+def build_floor(folder, n_in=6, n_out=6):
+    """Build the trivial FMU (``n_in`` inputs, ``n_out`` outputs) into ``folder``; returns its path."""
     from pythonfmu.builder import FmuBuilder
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    name = "hydrofmu_floor" if (n_in, n_out) == (6, 6) else f"hydrofmu_floor_{n_in}_{n_out}"
     with tempfile.TemporaryDirectory() as tmp:
-        script = Path(tmp) / "hydrofmu_floor.py"
-        script.write_text(FLOOR_SCRIPT)
+        script = Path(tmp) / f"{name}.py"
+        script.write_text(FLOOR_SCRIPT.format(name=name, n_in=n_in, n_out=n_out))
         saved = list(sys.path)
         try:
             return Path(FmuBuilder.build_FMU(script, dest=folder))

@@ -5,7 +5,9 @@ with drag and added mass) and two SIMO couplings: its own radiation memory and a
 interaction with a neighbour (full 6×6 realistic kernels, ``kernels.coupling_kernels``).
 Per step, the FMU gets its inputs (setReal), gives its total load (getReal: the feedthrough
 evaluation) and steps (doStep: commits the memory); in-process, the same kernel objects
-compute the same loads from the same inputs.  overhead = FMU time / in-process time.
+compute the same loads from the same inputs.  overhead = FMU time / in-process time.  The
+pythonfmu floor under the same three calls (a trivial FMU with as many inputs and outputs,
+``floor.build_floor``) tells how much of the difference is fmpy's and pythonfmu's own.
 """
 from pathlib import Path
 
@@ -88,12 +90,14 @@ def motions(n, dt):
 
 
 def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIMDEL):
-    """Seconds per step {'fmu', 'in_process'} and their ratio; builds into ``folder``."""
+    """Seconds per step {'fmu', 'in_process', 'floor'} and the ratio FMU/in-process; builds
+    into ``folder``."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
     from ..fmi.build import build_scene
     from ..scene import load_scene
+    from .floor import build_floor
 
     scene = load_scene(write_scene(folder, method, lags, dt))
     built = build_scene(scene, Path(folder) / "fmus", log=lambda *_: None)
@@ -108,8 +112,11 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
     values = np.hstack([pos, att, va, vb])
     env = Env(scene.rho, scene.g, scene.current_speed, scene.current_direction)
     body = scene.bodies["a"]
+    floor_path = str(build_floor(Path(folder) / "floor", len(inputs), len(outputs)))
+    floor_md = read_model_description(floor_path)
+    floor_unzipped = extract(floor_path)
 
-    def fmu_run():
+    def fmpy_run(md, unzipped, inputs, outputs):
         slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, instanceName="a",
                           modelIdentifier=md.coSimulation.modelIdentifier)
         slave.instantiate(loggingOn=False)
@@ -124,6 +131,14 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
             slave.getReal(outputs)
             slave.doStep(k * dt, dt)
         return step
+
+    def fmu_run():
+        return fmpy_run(md, unzipped, inputs, outputs)
+
+    def floor_run():
+        fvr = {v.name: v.valueReference for v in floor_md.modelVariables}
+        return fmpy_run(floor_md, floor_unzipped, [fvr[f"u[{i + 1}]"] for i in range(len(inputs))],
+                        [fvr[f"y[{i + 1}]"] for i in range(len(outputs))])
 
     def kernel_run():
         loads = body_loads(body)
@@ -141,7 +156,7 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
 
     slaves = []
     try:
-        cost = per_call({"fmu": fmu_run, "in_process": kernel_run}, steps, rounds)
+        cost = per_call({"fmu": fmu_run, "in_process": kernel_run, "floor": floor_run}, steps, rounds)
     finally:
         for slave in slaves:
             slave.terminate()

@@ -574,8 +574,10 @@ class DynamicsSlave(ArraySlave):
     def _loads(self):
         return (self._load_sum @ self.values[self._load_vrs]).reshape(-1, 6)
 
-    def _publish(self):
-        acc = self.solver.accelerations() if self.solver else self.bodies[0].acceleration
+    def _publish(self, acc=None):
+        """Motion outputs from the bodies' states and accelerations ``acc`` (default: computed)."""
+        if acc is None:
+            acc = self.solver.accelerations() if self.solver else self.bodies[0].acceleration
         self.values[self._motion_vrs] = np.concatenate([b._y for b in self.bodies] + [acc.ravel()])
 
     def step_physics(self, t, dt):
@@ -589,10 +591,10 @@ class DynamicsSlave(ArraySlave):
             rates = np.zeros_like(loads) if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
         if self.solver is not None:
-            self.solver.step(dt, loads, rates)
+            acc = self.solver.step(dt, loads, rates)
         else:
-            self.bodies[0].step(dt, loads[0], None if rates is None else rates[0])
-        self._publish()
+            acc = self.bodies[0].step(dt, loads[0], None if rates is None else rates[0])
+        self._publish(acc)
 
     def physics_state(self):
         if not hasattr(self, "bodies"):

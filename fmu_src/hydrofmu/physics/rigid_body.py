@@ -293,7 +293,8 @@ class _Equations:
             if rate is None:
                 l0, forcing = load, [base] * ns
             else:
-                l0, forcing = load + (m * h) * rate, base + np.outer((m + nodes) * h, rate)
+                l0 = load + (m * h) * rate if m else load
+                forcing = base + np.outer((m + nodes) * h, rate)
             kin, big0, rhs = start or self.start(yp, signs)
             stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big0, rhs + l0)
             if checked and not math.isfinite(_sum(stages[1])):
@@ -395,7 +396,8 @@ class RigidBody:
     def step(self, dt, external_load, load_rate=None):
         """Advance the state by dt [s] (≥ 0) with the external load [F; M about O] [N, N·m],
         global axes, held constant, or varying linearly at ``load_rate`` [N/s, N·m/s] from
-        its value at the start of the step.  dt = 0 only replaces the held load."""
+        its value at the start of the step.  dt = 0 only replaces the held load.  Returns the
+        acceleration after the step (``acceleration``)."""
         dt = float(dt)
         if not (math.isfinite(dt) and dt >= 0.0):
             raise self._error("dt", f"communication step must be finite and ≥ 0, found {dt}")
@@ -408,6 +410,7 @@ class RigidBody:
             if rate is not None:
                 load = load + rate * dt
         self._y, self._load = y, load
+        return self._eq.accelerations(y, load, self._start())
 
     def _start(self):
         """_Equations.start of the current state if the last step left it, else None."""
@@ -471,7 +474,8 @@ class CoupledBodies:
 
     def step(self, dt, loads, rates=None):
         """Advance all bodies by dt [s] with their external loads (list of (6,)) held, or
-        varying linearly at ``rates`` from their values at the start of the step."""
+        varying linearly at ``rates`` from their values at the start of the step.  Returns
+        the (n, 6) accelerations after the step (``accelerations``)."""
         loads = np.array(loads, dtype=float).ravel()
         last = self._last()
         y = last[0] if last else np.concatenate([b._y for b in self.bodies])
@@ -484,6 +488,7 @@ class CoupledBodies:
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
         self._end = ([b._y for b in self.bodies] + [b._load for b in self.bodies], y, loads, end)
+        return self._eq.accelerations(y, loads, end).reshape(-1, 6)
 
     def _last(self):
         """(state, loads, _Equations.start of the state or None) of all bodies as the last
