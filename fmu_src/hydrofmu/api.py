@@ -52,7 +52,8 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
         A scene file (``.toml``, validated first) or a Scene from `load_scene`.
     out : str or Path, default ``build/fmus``
         Parent folder: the scene is built into ``out/<scene name>/`` (FMUs,
-        ``manifest.json``, ``OspSystemStructure.xml``), replacing an earlier build only
+        ``manifest.json``, each FMU's ``<model>_OspModelDescription.xml``,
+        ``OspSystemStructure.xml``, ``<scene>.ssp``), replacing an earlier build only
         when the whole build succeeded.
     log : callable, default print
         Receives one line per built FMU and the build's reports (fits, stability

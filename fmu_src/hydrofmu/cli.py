@@ -39,7 +39,7 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
     for s in scenes:
         folders[s.name] = build_scene(s, outdir, log=log, check=check)
         if not check:
-            log(f"built scene {s.name}: FMUs, manifest.json and OspSystemStructure.xml in {folders[s.name]}")
+            log(f"built scene {s.name}: FMUs, manifest.json, OSP files and {s.name}.ssp in {folders[s.name]}")
     return folders
 
 
@@ -157,9 +157,10 @@ def make_parser():
     sub = parser.add_subparsers(dest="command", required=True, metavar="command")
     b = sub.add_parser("build", formatter_class=fmt, help="build the FMUs of scenes",
                        description="Validate every scene, then build each one into OUT/<scene name>/: one load FMU "
-                                   "per body, joint FMUs, dynamics-partner FMUs, manifest.json (our masters) and "
-                                   "OspSystemStructure.xml (libcosim).  A build replaces the folder only when it "
-                                   "succeeded.")
+                                   "per body, joint FMUs, dynamics-partner FMUs, manifest.json (our masters), each "
+                                   "FMU's <model>_OspModelDescription.xml (its OSP-IS ports) and "
+                                   "OspSystemStructure.xml (libcosim), <scene>.ssp (SSP).  A build replaces the "
+                                   "folder only when it succeeded.")
     b.add_argument("scenes", nargs="*", metavar="SCENE", help="scene files (.toml); none: every *.toml in models/")
     b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="parent folder of the built scenes")
     b.add_argument("--check", action="store_true", help="check the scenes and their decks as the build does; "
