@@ -76,17 +76,14 @@ def test_per_call_interleaves_and_restarts():
     assert set(res) == {"a", "b"} and all(v >= 0 for v in res.values())
 
 
-def test_floor_fmu_copies_its_inputs(tmp_path):
-    """The floor FMU built on the fly does what it claims: after a step y = u; the floor
-    system chains n of them in a ring (y of f_k feeds u of f_k+1) that the master runs."""
+def floor_steps(fmu, u):
+    """Outputs of a floor FMU before and after one step with inputs ``u``."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    from hydrofmu.bench import floor
-
-    fmu = floor.build_floor(tmp_path)
     md = read_model_description(str(fmu))
     vr = {v.name: v.valueReference for v in md.modelVariables}
+    ys = [vr[n] for n in sorted(vr) if n.startswith("y[")]
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)),
                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="f")
     slave.instantiate()
@@ -94,35 +91,30 @@ def test_floor_fmu_copies_its_inputs(tmp_path):
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
         slave.exitInitializationMode()
-        u = [1.5, -2.0, 3.25, 0.0, 7.0, -0.5]
-        slave.setReal([vr[f"u[{i}]"] for i in range(1, 7)], u)
-        assert slave.getReal([vr[f"y[{i}]"] for i in range(1, 7)]) == [0.0] * 6   # not before the step
+        slave.setReal([vr[f"u[{i + 1}]"] for i in range(len(u))], u)
+        before = slave.getReal(ys)
         slave.doStep(0.0, 0.05)
-        assert slave.getReal([vr[f"y[{i}]"] for i in range(1, 7)]) == u
+        return sorted(vr), before, slave.getReal(ys)
     finally:
         slave.terminate()
         slave.freeInstance()
+
+
+def test_floor_fmu_copies_its_inputs(tmp_path):
+    """The floor FMU built on the fly does what it claims: after a step y = u; the floor
+    system chains n of them in a ring (y of f_k feeds u of f_k+1) that the master runs.
+    Other sizes (bench.overhead's floor under a load FMU's calls): y_i = u_(i mod n_in)."""
+    from hydrofmu.bench import floor
+
+    fmu = floor.build_floor(tmp_path)
+    u = [1.5, -2.0, 3.25, 0.0, 7.0, -0.5]
+    _, before, after = floor_steps(fmu, u)
+    assert before == [0.0] * 6 and after == u   # not before the step
     folder = floor.floor_system(tmp_path, fmu, 3)
     assert floor.fmu_count(folder) == 3
     assert floor.per_step(folder, 20, 0.05) > 0 and floor.startup(folder) > 0
-    # other sizes (bench.overhead's floor under a load FMU's calls): y_i = u_(i mod n_in)
-    fmu = floor.build_floor(tmp_path / "sized", 4, 2)
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    assert sorted(vr) == ["u[1]", "u[2]", "u[3]", "u[4]", "y[1]", "y[2]"]
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="g")
-    slave.instantiate()
-    try:
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        slave.setReal([vr[f"u[{i}]"] for i in range(1, 5)], [1.0, 2.0, 3.0, 4.0])
-        slave.doStep(0.0, 0.05)
-        assert slave.getReal([vr["y[1]"], vr["y[2]"]]) == [1.0, 2.0]
-    finally:
-        slave.terminate()
-        slave.freeInstance()
+    names, _, after = floor_steps(floor.build_floor(tmp_path / "sized", 4, 2), [1.0, 2.0, 3.0, 4.0])
+    assert names == ["u[1]", "u[2]", "u[3]", "u[4]", "y[1]", "y[2]"] and after == [1.0, 2.0]
 
 
 def test_floor_spread_and_linearity_bookkeeping():
