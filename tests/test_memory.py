@@ -6,6 +6,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.linalg import expm
 
+from hydrofmu.physics import memory
 from hydrofmu.physics.memory import Convolution, Realisation, StateSpace, realise
 
 A, C, V, W = 0.5, 2.0, 1.3, 1.1          # h(t) = C·e^(−A·t), v = V·sin(W·t)
@@ -116,8 +117,10 @@ def test_state_space_is_exact_at_order_one():
     assert fit.C[0] * fit.B[0] == pytest.approx(c, abs=1e-6)
 
 
-def test_state_space_step_matches_block_matrix_exponential():
+@pytest.mark.parametrize("dense", [64, 0])   # a step as one real product / on the complex modes
+def test_state_space_step_matches_block_matrix_exponential(dense, monkeypatch):
     # two modes, one real, one oscillating; compare with scipy's expm of the augmented system
+    monkeypatch.setattr(memory, "DENSE_STATES", dense)
     a = np.array([[-0.4, 0.0, 0.0], [0.0, -0.2, 1.3], [0.0, -1.3, -0.2]])
     b, c = np.array([1.0, 1.0, 0.0]), np.array([2.0, -0.7, 0.4])
     fit = Realisation(a, b, c, 0.0)

@@ -581,9 +581,10 @@ class DynamicsSlave(ArraySlave):
         self.values[self._motion_vrs] = np.concatenate([b._y for b in self.bodies] + [acc.ravel()])
 
     def step_physics(self, t, dt):
-        if not self.check_finite(self.load_inputs):
+        x = self.values[self._load_vrs]
+        if not _finite(x.tolist()) and not self.check_finite(self.load_inputs):
             return
-        loads = self._loads()
+        loads = (self._load_sum @ x).reshape(-1, 6)
         rates = None
         if self.config.load_hold == "linear":
             # first-order hold: extrapolate the load with its slope over the last step

@@ -199,7 +199,7 @@ class CurrentPolar:
     def load(self, motion, env):
         """[force N; moment N·m about the reference point], global axes."""
         # plain floats throughout: numpy's per-call cost dominates on 3-vectors
-        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = motion.rot.tolist()
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = motion.rot_rows
         px, py, pz = self.xc, self.yc, self.zc
         rx, ry, rz = r00 * px + r01 * py + r02 * pz, r10 * px + r11 * py + r12 * pz, r20 * px + r21 * py + r22 * pz
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()

@@ -11,18 +11,21 @@ import math
 import numpy as np
 
 
-def rotation(attitude):
-    """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) for attitude (φ, θ, ψ) [rad]."""
-    # plain floats: numpy's per-call cost dominates on three angles
+def rotation_rows(attitude):
+    """The rows of R = Rz(ψ)·Ry(θ)·Rx(φ) for attitude (φ, θ, ψ) [rad], as three tuples of
+    floats (numpy's per-call cost dominates on three angles)."""
     phi, theta, psi = attitude.tolist() if isinstance(attitude, np.ndarray) else map(float, attitude)
     cf, sf = math.cos(phi), math.sin(phi)
     ct, st = math.cos(theta), math.sin(theta)
     cp, sp = math.cos(psi), math.sin(psi)
-    return np.array([
-        [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
-        [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
-        [-st, ct * sf, ct * cf],
-    ])
+    return ((cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf),
+            (sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf),
+            (-st, ct * sf, ct * cf))
+
+
+def rotation(attitude):
+    """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) for attitude (φ, θ, ψ) [rad]."""
+    return np.array(rotation_rows(attitude))
 
 
 def cross(a, b):

@@ -362,6 +362,9 @@ def _phi(x):
     return p1, p2
 
 
+DENSE_STATES = 64   # up to this many real states a step is one dense real product (StateSpace)
+
+
 class StateSpace:
     """Memory integral by state-space realisations of the kernels.
 
@@ -425,8 +428,10 @@ class StateSpace:
         self._peeked = None
 
     def _discrete(self, dt):
-        """(e^{μdt}, B) for a step dt: z_new = e·z + B·[v_old; v_new], with B (real view,
-        2·modes × 2·n_in) holding dt·(φ₁ − φ₂) on v_old and dt·φ₂ on v_new of each mode's input."""
+        """(e^{μdt}, B, W) for a step dt: z_new = e·z + B·[v_old; v_new], with B (real view,
+        2·modes × 2·n_in) holding dt·(φ₁ − φ₂) on v_old and dt·φ₂ on v_new of each mode's input;
+        W (up to DENSE_STATES real states, else None) gives [z_new; F] = W·[z; v_old; v_new] on
+        the real view in one product (cheaper than four small numpy calls)."""
         if dt == self._last_dt:                   # the usual case: a constant step
             return self._last
         key = float(dt)
@@ -439,7 +444,15 @@ class StateSpace:
             b[np.arange(m), n_in + self._inp] = dt * p2
             real = np.empty((2 * m, 2 * n_in))
             real[0::2], real[1::2] = b.real, b.imag
-            self._cache[key] = (np.exp(x), real)
+            e = np.exp(x)
+            whole = None
+            if 2 * m <= DENSE_STATES:   # few states: the whole step as one real product
+                rot = np.zeros((2 * m, 2 * m))      # e·z on the real view: blocks [[Re e, −Im e], [Im e, Re e]]
+                i = 2 * np.arange(m)
+                rot[i, i], rot[i, i + 1], rot[i + 1, i], rot[i + 1, i + 1] = e.real, -e.imag, e.imag, e.real
+                top = np.hstack([rot, real])
+                whole = np.vstack([top, self._gain @ top])
+            self._cache[key] = (e, real, whole)
             if len(self._cache) > 16:
                 self._cache.popitem(last=False)
         self._cache.move_to_end(key)
@@ -454,7 +467,10 @@ class StateSpace:
             v_new = v_new.reshape(self._v.shape)
         z, force = self._z, self.force
         if self._mu.size:
-            e, b = self._discrete(dt)
+            e, b, whole = self._discrete(dt)
+            if whole is not None:   # [z_new (real view); F] = whole·[z (real view); v_old; v_new]
+                out = whole @ np.concatenate((z.view(float), self._v, v_new))
+                return float(dt), v_new, out[:2 * z.size].view(complex), out[2 * z.size:]
             u = self._u
             u[:v_new.size], u[v_new.size:] = self._v, v_new
             z = e * z + (b @ u).view(complex)

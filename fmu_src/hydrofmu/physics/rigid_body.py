@@ -294,7 +294,7 @@ class _Equations:
                 l0, forcing = load, [base] * ns
             else:
                 l0 = load + (m * h) * rate if m else load
-                forcing = base + np.outer((m + nodes) * h, rate)
+                forcing = base + ((m + nodes) * h)[:, None] * rate
             kin, big0, rhs = start or self.start(yp, signs)
             stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big0, rhs + l0)
             if checked and not math.isfinite(_sum(stages[1])):

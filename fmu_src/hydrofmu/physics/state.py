@@ -17,7 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .kinematics import current_velocity, rotation
+from .kinematics import current_velocity, rotation_rows
 
 
 @dataclass
@@ -33,10 +33,15 @@ class Motion:
     acceleration: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
     @cached_property
+    def rot_rows(self):
+        """The rows of R as tuples of floats (computed once: a Motion is a snapshot, every
+        effect of an evaluation reads it; kernels on plain floats take these)."""
+        return rotation_rows(self.attitude)
+
+    @cached_property
     def rot(self):
-        """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ) (computed once: a Motion
-        is a snapshot, every effect of an evaluation reads it)."""
-        return rotation(self.attitude)
+        """Body-to-global rotation matrix R = Rz(ψ)·Ry(θ)·Rx(φ)."""
+        return np.array(self.rot_rows)
 
 
 @dataclass
