@@ -14,6 +14,9 @@ Parts (each also callable alone, see ``PARTS``):
   good; memory per fmi2Instantiate/fmi2FreeInstance cycle (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
+- ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
+  case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
+  took against the bonds' power (``ecco_cost``)
 
 ``quick`` shrinks every part (for a smoke run); the figures in the README come from a full run.
 """
@@ -22,6 +25,7 @@ import time
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -107,8 +111,13 @@ def plot_memory_tradeoff(rows, path):
 
 
 def part_sweep(out, quick):
+    from . import ecco_cost
     steps = (0.2, 0.1, 0.05) if quick else (0.2, 0.1, 0.05, 0.02, 0.01)
-    rows = cosim_cost.step_sweep(out / "sweep", steps=steps, stop=20.0 if quick else 60.0)
+    stop = 20.0 if quick else 60.0
+    rows = cosim_cost.step_sweep(out / "sweep", steps=steps, stop=stop)
+    # libcosim's ECCO on the same scene (adaptive step), one point per energy tolerance
+    rows = cosim_cost.pareto([{**r, "tolerance": ""} for r in rows]
+                             + ecco_cost.sweep_rows(out / "sweep", stop, (1e-3,) if quick else (1e-2, 1e-3, 1e-4)))
     write_csv(out / "step_sweep.csv", rows)
     fig, ax = plt.subplots(figsize=(7, 5))
     for alg in ("jacobi", "gauss-seidel"):
@@ -116,22 +125,105 @@ def part_sweep(out, quick):
             rs = [r for r in rows if r["algorithm"] == alg and r["load_hold"] == hold]
             ax.loglog([r["wall_s"] for r in rs], [r["error"] for r in rs], "o-" if alg != "jacobi" else "s--",
                       label=f"{alg}, {hold} hold")
+    rs = sorted((r for r in rows if r["algorithm"] == "ecco"), key=lambda r: r["wall_s"])
+    ax.loglog([r["wall_s"] for r in rs], [r["error"] for r in rs], "D-", color="C4",
+              label="ECCO (libcosim), linear hold")
     front = sorted((r for r in rows if r["pareto"]), key=lambda r: r["wall_s"])
     ax.loglog([r["wall_s"] for r in front], [r["error"] for r in front], "k:", lw=2, label="Pareto front")
     ax.set_xlabel("wall time [s]")
     ax.set_ylabel("error vs monolithic (normalised RMS)")
-    ax.set_title("Two bodies, SIMO interaction: communication step sweep (labels: step [s])")
+    ax.set_title("Two bodies, SIMO interaction: communication step sweep\n"
+                 "(labels: step [s]; ECCO: energy tolerance)", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     legend = ax.legend(fontsize=8)
     from ..cosim.report import annotate_apart, plain_log_ticks
     plain_log_ticks(ax)
     fig.tight_layout()
-    annotate_apart(ax, [r["wall_s"] for r in rows], [r["error"] for r in rows], [f"{r['step']:g}" for r in rows],
+    annotate_apart(ax, [r["wall_s"] for r in rows], [r["error"] for r in rows],
+                   [f"tol {r['tolerance']:g}" if r["algorithm"] == "ecco" else f"{r['step']:g}" for r in rows],
                    avoid=(legend,))
     fig.savefig(out / "step_sweep.png", dpi=120)
     plt.close(fig)
-    return [f"Pareto: {r['algorithm']}, {r['load_hold']} hold, step {r['step']:g} s: "
-            f"{100 * r['error']:.3g} % in {r['wall_s']:.1f} s" for r in front]
+    what = lambda r: (f"ECCO, tolerance {r['tolerance']:g} (mean step {r['step']:.3g} s)" if r["algorithm"] == "ecco"
+                      else f"{r['algorithm']}, {r['load_hold']} hold, step {r['step']:g} s")
+    return [f"Pareto: {what(r)}: {100 * r['error']:.3g} % in {r['wall_s']:.1f} s" for r in front]
+
+
+def part_ecco(out, quick):
+    from . import ecco_cost
+    rows, traces = ecco_cost.measure(out / "ecco", stop=20.0 if quick else 60.0,
+                                     steps=(0.1, 0.05) if quick else (0.1, 0.05, 0.02),
+                                     tolerances=(1e-3,) if quick else (1e-2, 1e-3, 1e-4),
+                                     fine=0.01 if quick else 0.005)
+    rows = [r for case in dict.fromkeys(r["case"] for r in rows)
+            for r in cosim_cost.pareto([r for r in rows if r["case"] == case])]
+    write_csv(out / "ecco.csv", rows)
+    plot_ecco(rows, out / "ecco.png")
+    plot_ecco_steps(traces, out / "ecco_steps.png")
+    lines = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        mine = [r for r in rows if r["case"] == case]
+        for r in mine:
+            if r["algorithm"] == "ecco" or r["pareto"]:
+                lines.append(f"{case}: {r['algorithm']}, {r['knob']}: {100 * r['error']:.3g} % in {r['steps']} steps "
+                             f"({r['min_step']:.3g}–{r['max_step']:.3g} s), {r['wall_s']:.2f} s, energy residual "
+                             f"{r['residual_J']:.3g} J = {100 * r['residual_rel']:.2g} % of the bonds' energy"
+                             + (" [Pareto]" if r["pareto"] else ""))
+    return lines
+
+
+def plot_ecco(rows, path):
+    """Error against wall time per case: fixed steps per algorithm, ECCO per tolerance."""
+    from ..cosim.report import plain_log_ticks
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    fig, axes = plt.subplots(1, len(cases), figsize=(4.2 * len(cases), 4.2), squeeze=False)
+    style = {"jacobi": "s--", "gauss-seidel": "o-", "jacobi (libcosim)": "v:", "ecco": "D-"}
+    for ax, case in zip(axes[0], cases):
+        for alg, fmt in style.items():
+            rs = sorted((r for r in rows if r["case"] == case and r["algorithm"] == alg), key=lambda r: r["wall_s"])
+            ax.loglog([r["wall_s"] for r in rs], [r["error"] for r in rs], fmt, label=alg)
+            for r in rs:
+                ax.annotate(r["knob"].split()[-1] if alg != "ecco" else f"tol {r['knob'].split()[-1]}",
+                            (r["wall_s"], r["error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        ax.set(xlabel="wall time [s]", title=case)
+        ax.grid(True, which="both", alpha=0.3)
+        plain_log_ticks(ax)
+    axes[0][0].set_ylabel("error (normalised RMS)")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle("ECCO (libcosim) beside fixed steps: two-body vs monolithic, models/ vs fine Gauss–Seidel "
+                 "(labels: step [s], ECCO tolerance)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_ecco_steps(traces, path):
+    """The step ECCO took against time (left axis) with the power through the bonds
+    |Σ F·v| (right axis), per case."""
+    from ..cosim import bonds
+    fig, axes = plt.subplots(len(traces), 1, figsize=(9, 2.6 * len(traces)), squeeze=False)
+    for ax, (case, result) in zip(axes[:, 0], traces.items()):
+        res = bonds.residual(result)
+        t = result.time[1:]
+        ax.semilogy(t, res.step, color="C0", lw=1)
+        ax.set_ylabel("step [s]", color="C0")
+        right = ax.twinx()
+        right.semilogy(t, np.abs(res.power) + 1e-30, color="C3", lw=0.8, alpha=0.7)
+        right.semilogy(t, np.abs(res.residual) / res.step + 1e-30, color="C2", lw=0.8, alpha=0.7)
+        right.set_ylabel("power [W]")
+        right.legend(handles=[plt.Line2D([], [], color="C0", label="ECCO's step"),
+                              plt.Line2D([], [], color="C3", label="|Σ F·v| through the bonds"),
+                              plt.Line2D([], [], color="C2", label="residual power |δE|/h")],
+                     fontsize=7, loc="upper right")
+        ax.set_title(f"{case}: {len(t)} steps, {res.step.min():.3g}–{res.step.max():.3g} s "
+                     f"(rel_tolerance {result.settings['ecco']['rel_tolerance']:g})", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[-1][0].set_xlabel("time [s]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
 
 
 def part_growth(out, quick):
@@ -252,7 +344,7 @@ def part_batch(out, quick):
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "stability": part_stability, "bem": part_bem,
-         "robust": part_robust, "batch": part_batch}
+         "robust": part_robust, "batch": part_batch, "ecco": part_ecco}
 
 
 def main(out, parts=None, quick=False, log=print):

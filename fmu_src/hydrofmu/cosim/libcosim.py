@@ -26,10 +26,11 @@ from .result import Result, column_units
 NS = 1_000_000_000
 
 
-def run(folder, stop=None, step=None, record=None, algorithm=None):
+def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
     """Run the scene built in ``folder`` (its manifest.json) in libcosim; returns a Result
     with the same columns as cosim.master.run (default: every output of every FMU).
     ``algorithm`` (default: the scene's) must be 'jacobi' or 'ecco': InputError otherwise.
+    ``ecco``: ECCO settings over the scene's (``{'rel_tolerance': 1e-4}``, keys of ``[run.ecco]``).
     An ECCO run's time points are the ones it chose; it ends at the first at or after
     ``stop``, and its Result records every power bond's force and velocity too."""
     from libcosimpy.CosimAlgorithm import CosimAlgorithm, EccoParams
@@ -54,7 +55,11 @@ def run(folder, stop=None, step=None, record=None, algorithm=None):
     step_ns = int(round(step * NS))
     settings = run_settings(manifest, step, wanted, stop)
     if wanted == "ecco":
-        ecco = settings["ecco"]
+        from ..scene import ECCO_DEFAULTS
+        unknown = set(ecco or {}) - set(ECCO_DEFAULTS)
+        if unknown:
+            raise InputError("ecco", None, sorted(unknown)[0], f"not an ECCO setting ({', '.join(ECCO_DEFAULTS)})")
+        settings["ecco"] = ecco = {**settings["ecco"], **(ecco or {})}
         if not ecco["min_step"] <= step <= ecco["max_step"]:
             raise InputError("--step", None, "step", f"ECCO's first step must lie within [min_step, max_step] = "
                              f"[{ecco['min_step']:g}, {ecco['max_step']:g}] s, found {step:g}")
