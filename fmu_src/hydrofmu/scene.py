@@ -367,7 +367,7 @@ PRESETS = {
                "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None}},
     "reference": {"step": 0.01, "algorithm": "gauss-seidel", "substep": 0.005, "load_hold": "linear",
                   "memory": {"method": "convolution", "tolerance": 0.01, "memory_length": None}},
-    "adaptive": {"step": 0.05, "algorithm": "ecco", "substep": 0.01, "load_hold": "linear",
+    "adaptive": {"step": 0.01, "algorithm": "ecco", "substep": 0.01, "load_hold": "linear",
                  "memory": {"method": "state_space", "tolerance": 0.01, "memory_length": None},
                  "ecco": dict(ECCO_DEFAULTS)},
 }
