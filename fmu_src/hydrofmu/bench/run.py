@@ -169,7 +169,8 @@ def part_ecco(out, quick):
                              f"({r['min_step']:.3g}–{r['max_step']:.3g} s), {r['wall_s']:.2f} s, energy residual "
                              f"{r['residual_J']:.3g} J = {100 * r['residual_rel']:.2g} % of the bonds' energy"
                              + (" [Pareto]" if r["pareto"] else ""))
-    return lines
+    return lines + ["wall times are single runs (not interleaved): compare the steps and errors, not the seconds, "
+                    "on a shared machine"]
 
 
 def plot_ecco(rows, path):
