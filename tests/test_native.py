@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from conftest import MODELS
+from hydrofmu.bench.robust import FLAT_KB, STEP_KB, growth
 
 pytest.importorskip("libcosimpy")
 NATIVE = Path(__file__).with_name("native")
@@ -328,6 +329,45 @@ def test_two_threads_two_instances(hosts, load_fmu):
         theirs = np.array([got[k, n, o] for n, o in ref])
         np.testing.assert_array_equal(theirs, np.array(list(ref.values())))
     assert got[0, steps, outputs[0]] != got[1, steps, outputs[0]]  # the instances differ
+
+
+def cycled(hosts, unzipped, cycles, every, inputs, outputs, steps=5, dt=0.1):
+    """The generic host after FMI_HOST_CYCLES: ({cycle: RSS kB}, {(instance, step, vr): value}),
+    and the same run in a fresh process (no cycles before): its values."""
+    run, got = run_fmi_host(hosts, unzipped, 1, steps, dt, inputs, outputs,
+                            env=clean_env(FMI_HOST_CYCLES=f"{cycles}:{every}"))
+    assert run.returncode == 0 and "host exits normally" in run.stdout, run.stdout[-2000:] + run.stderr
+    assert "LOG" not in run.stdout and "failed" not in run.stdout, run.stdout[-2000:]
+    rss = {int(p[1]): int(p[2]) for p in (line.split() for line in run.stdout.splitlines()) if p[:1] == ["rss"]}
+    assert sorted(rss) == list(range(every, cycles + 1, every))
+    return rss, got, run_fmi_host(hosts, unzipped, 1, steps, dt, inputs, outputs)[1]
+
+
+def test_ten_thousand_instantiate_free_cycles_at_flat_memory(hosts, load_fmu):
+    """10⁴ fmi2Instantiate … fmi2FreeInstance cycles of one load FMU in a native host, each
+    initialised and stepped once: resident memory is flat over the last 9000 (bench/robust.py:
+    FLAT_KB and STEP_KB, and what they rest on; without the pool it grows 12 MB).  The
+    run's instance then (a pooled one, reset) steps bit for bit like a fresh process's."""
+    vr = load_fmu[3]
+    inputs = {vr["position[1]"]: 2.0, vr["position[2]"]: -1.0, vr["velocity[1]"]: 0.3, vr["velocity[6]"]: 0.01}
+    outputs = [vr[f"force[{i}]"] for i in range(1, 7)]
+    rss, got, fresh = cycled(hosts, load_fmu, 10_000, 1000, inputs, outputs)
+    steady, step = growth([rss[k] for k in sorted(rss)])
+    assert steady < FLAT_KB and step < STEP_KB, rss
+    assert got == fresh and len(got) == 30
+
+
+def test_dynamics_fmu_cycles_at_flat_memory(hosts, scenes, tmp_path):
+    """The same for a dynamics FMU (a state that integrates), 3000 cycles, flat after 500;
+    the pooled instance, stepped with other forces in every cycle, restarts from rest."""
+    dyn = unzip(scenes["moored_barge"] / "moored_barge_barge_dynamics.fmu", tmp_path)
+    vr = dyn[3]
+    inputs = {vr["force[1]"]: 1e3, vr["force[3]"]: -5e2, vr["force[5]"]: 2e3}
+    outputs = [vr[f"position[{i}]"] for i in range(1, 4)] + [vr[f"attitude[{i}]"] for i in range(1, 4)]
+    rss, got, fresh = cycled(hosts, dyn, 3000, 500, inputs, outputs)
+    steady, step = growth([rss[k] for k in sorted(rss)])
+    assert steady < FLAT_KB and step < STEP_KB, rss
+    assert got == fresh and len(got) == 30 and got[0, 5, outputs[0]] != 0.0
 
 
 def test_two_fmus_start_python_at_once(hosts, load_fmu, tmp_path):

@@ -1,9 +1,11 @@
 """The FMI shim: doStep's Discard becomes Error, warnings and errors always reach the
-host's logger, everything else is forwarded.
+host's logger, freed instances come back from its pool, everything else is forwarded.
 
-A tiny pythonfmu FMU (y = 2 x; do_step logs an error and returns False on a
-non-finite x, else logs an info line) is built once per module, shimmed, and driven
-through fmpy and libcosimpy.
+A tiny pythonfmu FMU (y = 2 x, `steps` counts do_step calls; do_step logs an error and
+returns False on a non-finite x, else logs an info line) is built once per module,
+shimmed, and driven through fmpy and libcosimpy.  Its script counts how often pythonfmu
+runs it (RUNS: at every fresh fmi2Instantiate) and how many slave objects it makes
+(INITS: also at fmi2Reset).
 """
 
 import math
@@ -45,18 +47,24 @@ import math
 from pythonfmu import Fmi2Causality, Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Status
 
+globals()["RUNS"] = globals().get("RUNS", 0) + 1
+
 
 class {cls}(Fmi2Slave):
     def __init__(self, **kwargs):
         ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
+        globals()["INITS"] = globals().get("INITS", 0) + 1
         super().__init__(**kwargs)
         self.x = 0.0
         self.y = 0.0
+        self.steps = 0.0
         self.register_variable(Real("x", causality=Fmi2Causality.input))
         self.register_variable(Real("y", causality=Fmi2Causality.output))
+        self.register_variable(Real("steps", causality=Fmi2Causality.output))
         self.log("made")  # an info line logged inside fmi2Instantiate
 
     def do_step(self, current_time, step_size):
+        self.steps += 1.0
         if not math.isfinite(self.x):
             self.log("x is not finite", status=Fmi2Status.error)
             return False
@@ -415,3 +423,123 @@ def test_libcosimpy(fmus, capfd):
     # libcosim instantiates with logging off; the error still reaches its log
     out = capfd.readouterr()
     assert "x is not finite" in out.out + out.err
+
+
+# ---- the instance pool (shim.c): freed instances handed back after fmi2Reset ----
+
+class Cycler:
+    """fmpy instantiating and freeing instances of one unzipped copy of the FMU (fmpy loads
+    the library at every instance and unloads it at every fmi2FreeInstance); ``counts()``
+    is (RUNS, INITS) of the FMU's script (module docstring)."""
+
+    def __init__(self, fmu, folder):
+        self.md = read_model_description(str(fmu))
+        self.folder = extract(str(fmu), unzipdir=str(folder))
+        self.module = (folder / "resources" / "slavemodule.txt").read_text().strip()
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+
+    def counts(self):
+        m = sys.modules[self.module]
+        return m.RUNS, m.INITS
+
+    def instantiate(self, name, log=None, env=0, logging=False):
+        s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.folder,
+                      modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(
+            lambda e, inst, st, cat, msg: log is not None and log.append((e, st, msg.decode())))
+        cb.componentEnvironment = c_void_p(env)
+        s.instantiate(callbacks=cb, loggingOn=logging)
+        s.kept_callbacks = cb   # alive as long as the instance
+        return s
+
+    def step(self, s, x):
+        """Initialise, one step with input x; returns (y, steps) or None when the step failed."""
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        s.setReal([self.vr["x"]], [x])
+        try:
+            s.doStep(0.0, 0.1)
+        except FMICallException:
+            return None
+        return tuple(s.getReal([self.vr["y"], self.vr["steps"]]))
+
+    def cycle(self, name, x=None, **kw):
+        s = self.instantiate(name, **kw)
+        try:
+            return None if x is None else self.step(s, x)
+        finally:
+            s.freeInstance()
+
+
+def test_pool_hands_back_a_freed_instance_reset(fmus, tmp_path):
+    """The same instance instantiated and freed over and over: the first two are new, the
+    shim pools the second (an instance seen before) and hands it back from then on, after
+    fmi2Reset (a new slave object, the script not run again), in a fresh state (one step:
+    steps = 1); another instance name is not served from the pool."""
+    c = Cycler(fmus[1], tmp_path / "copy")
+    runs, inits = c.counts()
+    for k in range(6):
+        assert c.cycle("a", x=float(k)) == (2.0 * k, 1.0)
+    assert c.counts() == (runs + 2, inits + 6)
+    assert c.cycle("b", x=1.0) == (2.0, 1.0)
+    assert c.counts() == (runs + 3, inits + 7)
+
+
+def test_pooled_instance_takes_the_new_hosts_callbacks(fmus, tmp_path):
+    """A reused instance logs to the logger and componentEnvironment of the fmi2Instantiate
+    that got it, and follows its loggingOn ("made" is logged in the slave's __init__, so
+    at fmi2Reset too); errors reach it with logging off."""
+    c = Cycler(fmus[1], tmp_path / "copy")
+    c.cycle("a")
+    c.cycle("a")   # pooled from here on
+    runs, _ = c.counts()
+    loud, quiet = [], []
+    assert c.cycle("a", x=1.0, log=loud, env=0x1111, logging=True) == (2.0, 1.0)
+    assert c.cycle("a", x=math.nan, log=quiet, env=0x2222) is None
+    assert c.counts()[0] == runs   # both reused
+    assert loud == [(0x1111, fmi2OK, "made"), (0x1111, fmi2OK, HELLO)]
+    assert quiet == [(0x2222, fmi2Error, "x is not finite")]
+
+
+def test_pool_holds_at_most_eight_instances(fmus, tmp_path):
+    """Ten instances alive at once, freed, three times over: the second round's first eight
+    are pooled (the others freed), so the third round makes two new ones."""
+    c = Cycler(fmus[1], tmp_path / "copy")
+    names = [f"n{i}" for i in range(10)]
+
+    def round_():
+        slaves = [c.instantiate(n) for n in names]
+        for s in slaves:
+            s.freeInstance()
+
+    round_()
+    round_()
+    runs, _ = c.counts()
+    round_()
+    assert c.counts()[0] == runs + 2
+
+
+def test_pool_off(fmus, tmp_path, monkeypatch):
+    """HYDROFMU_POOL=0: every fmi2Instantiate makes a new instance."""
+    monkeypatch.setenv("HYDROFMU_POOL", "0")
+    c = Cycler(fmus[1], tmp_path / "copy")
+    runs, _ = c.counts() if c.module in sys.modules else (0, 0)
+    for _ in range(4):
+        c.cycle("a")
+    assert c.counts()[0] == runs + 4
+
+
+def test_freed_right_after_instantiate_with_a_queued_message(fmus, tmp_path):
+    """pythonfmu 0.7 crashed the host when an instance whose __init__ logged was freed before
+    any other call (the message still queued); the shim delivers the message first, to the
+    host that frees, also when the instance goes to the pool."""
+    c = Cycler(fmus[1], tmp_path / "copy")
+    log = []
+    c.cycle("a", log=log, env=7, logging=True)
+    assert log == [(7, fmi2OK, "made")]
+    log.clear()
+    c.cycle("a")
+    c.cycle("a", log=log, env=8, logging=True)   # reused (reset: "made" again), freed to the pool
+    assert log == [(8, fmi2OK, "made")]

@@ -11,6 +11,11 @@
  * ("vr,vr").  Log messages are printed as "LOG status category: message" (a NULL
  * category as "NULL-CATEGORY").  A failed fmi2Instantiate prints "instantiate: NULL" and
  * the host goes on to exit 0: an FMU failing must not take its host down.
+ *
+ * FMI_HOST_CYCLES=N:EVERY first instantiates "instance0" of the first copy N times, each
+ * time initialised and stepped once with the inputs times 7 (values the run never sets),
+ * then freed, and prints "rss CYCLE KB" (resident memory) every EVERY cycles; the run
+ * follows, so its instance 0 comes after N instances of the same name.
  */
 #include <dlfcn.h>
 #include <pthread.h>
@@ -18,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 typedef void *C;
 typedef struct {
@@ -58,6 +64,38 @@ static void logger(void *env, const char *name, int status, const char *cat, con
     printf("LOG %d %s: %s\n", status, cat ? cat : "NULL-CATEGORY", text);
     fflush(stdout);
     pthread_mutex_unlock(&print_lock);
+}
+
+static long rss_kb(void) {
+    long pages = 0, resident = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+        fclose(f);
+    }
+    return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+static void cycles(long n, long every) {
+    const Fmi fmi = fmis[0];
+    char uri[4200];
+    snprintf(uri, sizeof uri, "file://%s/resources", dirs[0]);
+    Callbacks cb = {logger, calloc, free, NULL, NULL};
+    double in[64];
+    for (int i = 0; i < nin; i++) in[i] = in_val[i] * 7.0;
+    for (long k = 1; k <= n; k++) {
+        C c = fmi.Instantiate("instance0", 1, guid, uri, &cb, 0, 0);
+        if (!c) {
+            printf("instantiate: NULL\n");
+            return;
+        }
+        if (fmi.SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0) || fmi.EnterInitializationMode(c) ||
+            fmi.ExitInitializationMode(c) || fmi.SetReal(c, in_vr, nin, in) || fmi.DoStep(c, 0.0, dt, 1))
+            printf("cycle %ld: an FMI call failed\n", k);
+        fmi.Terminate(c);
+        fmi.FreeInstance(c);
+        if (every > 0 && k % every == 0) printf("rss %ld %ld\n", k, rss_kb());
+    }
 }
 
 static void *run(void *arg) {
@@ -119,6 +157,9 @@ int main(int argc, char **argv) {
                 return 1;
             }
     }
+    const char *cyc = getenv("FMI_HOST_CYCLES");
+    long n = 0, every = 0;
+    if (cyc && sscanf(cyc, "%ld:%ld", &n, &every) >= 1) cycles(n, every);
     pthread_t t[16];
     for (long k = 0; k < threads && k < 16; k++) pthread_create(&t[k], NULL, run, (void *)k);
     for (long k = 0; k < threads && k < 16; k++) pthread_join(t[k], NULL);

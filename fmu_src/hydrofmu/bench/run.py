@@ -11,7 +11,8 @@ Parts (each also callable alone, see ``PARTS``):
 - stability: added-mass stability map, explicit against export (``stability``)
 - bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 - robust: time to report one bad number near the end of a 50 MB deck against reading it
-  good; memory per fmi2Instantiate/fmi2FreeInstance cycle (``robust``)
+  good; memory over fmi2Instantiate/fmi2FreeInstance cycles with and without the shim's
+  instance pool (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
@@ -322,14 +323,24 @@ def part_robust(out, quick):
     from ..scene import load_scene
     folder = build_scene(load_scene(Path("models") / "moored_barge.toml"),
                          out / "robust", log=lambda *_: None)
-    cycles = 1000 if quick else 10_000
-    per_cycle, seconds = robust.instantiate_cycles(folder / "moored_barge_barge.fmu", cycles)
-    write_csv(out / "robust.csv", [{**{k: v for k, v in r.items() if k != "error"},
-                                    "cycles": cycles, "kB_per_cycle": per_cycle, "cycle_s": seconds / cycles}])
+    cycles = 2000 if quick else 10_000
+    fmu = folder / "moored_barge_barge.fmu"
+    off = robust.instantiate_cycles(fmu, cycles, pool=False)   # side by side, pool off first
+    on = robust.instantiate_cycles(fmu, cycles)
+    rows = [{**{k: v for k, v in r.items() if k != "error"}, "pool": p, "cycles": c["cycles"],
+             "growth_kB": c["growth_kB"], "steady_kB": robust.growth(c["rss_kB"])[0],
+             "kB_per_cycle": c["kB_per_cycle"], "cycle_s": c["cycle_s"]} for p, c in (("off", off), ("on", on))]
+    write_csv(out / "robust.csv", rows)
+    steady, step = robust.growth(on["rss_kB"])
+    flat = steady < robust.FLAT_KB and step < robust.STEP_KB
     return [f"one bad number near the end of a {r['megabytes']:.0f} MB SIMO deck: reported in {r['bad_s']:.2f} s, "
             f"the good deck reads in {r['good_s']:.2f} s (ratio {r['ratio']:.2f}, best of 2, side by side)",
-            f"{cycles} fmi2Instantiate/fmi2FreeInstance cycles of a load FMU: {per_cycle:.2f} kB per cycle "
-            f"({1e3 * seconds / cycles:.1f} ms per cycle)"]
+            f"{cycles} fmi2Instantiate/fmi2FreeInstance cycles of a load FMU through fmpy after 1000 of warm-up, "
+            f"resident memory: {on['growth_kB']:.0f} kB ({on['kB_per_cycle']:.3f} kB per cycle; "
+            f"{steady:.0f} kB besides its largest step of {step:.0f} kB: {'flat' if flat else 'NOT flat'}) "
+            f"with the shim's instance pool, {off['growth_kB']:.0f} kB ({off['kB_per_cycle']:.2f} kB per cycle) "
+            f"without (HYDROFMU_POOL=0); {1e3 * on['cycle_s']:.1f} ms against {1e3 * off['cycle_s']:.1f} ms "
+            f"per cycle (×{off['cycle_s'] / on['cycle_s']:.1f})"]
 
 
 def part_batch(out, quick):

@@ -35,6 +35,26 @@
  * initialised and leaves it alone.  Every forwarded call holds the GIL (pythonfmu
  * takes it too; PyGILState calls nest), so hosts may call from any thread.
  * A failure is kept and reported by fmi2Instantiate as one log message.
+ *
+ * Instance pool: pythonfmu 0.7's fmi2Instantiate leaks ~1.2 kB of Python objects every
+ * time (it inserts a new string into sys.path and runs the slave script again, keeping the
+ * list and repr strings of every MRO it inspects), so a host that instantiates and frees
+ * over and over grows without bound.  The shim therefore keeps freed pythonfmu components
+ * (at most POOL_MAX per loaded FMU) and hands one back to an fmi2Instantiate with the same
+ * instance name, type, GUID, resource location and visibility -- everything pythonfmu keeps
+ * from its own fmi2Instantiate -- after pythonfmu's fmi2Reset, which builds a new Python
+ * slave object exactly as fmi2Instantiate does.  What belongs to the host's instance
+ * (logger, componentEnvironment, stepFinished, loggingOn and categories, the memory of the
+ * handle) lives in the Shim and is new at every fmi2Instantiate; the pythonfmu component
+ * is given the shim's own callbacks (calloc/free, a logger that forwards to whichever host
+ * instance holds it now), so it can outlive the host instance that created it.
+ * Only instances seen to come back are pooled: those whose fmi2Instantiate arguments were
+ * given before in this process.  A host may unload the library in between (fmpy does at
+ * every fmi2FreeInstance), so that record is kept in the interpreter (a set of key hashes,
+ * sys._hydrofmu_shim_instances, at most SEEN_MAX).  Pooling pins the library, and with it
+ * pythonfmu's, in memory (the pooled components call back into it: ~0.35 MB per FMU copy).
+ * An FMU copy used once (fmpy's simulate_fmu extracts a fresh copy per run) keeps nothing.
+ * HYDROFMU_POOL=0 (read when the library loads) turns pooling off.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -45,6 +65,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,6 +164,8 @@ static void *inner_handle;
 static int inner_ok;
 static char inner_err[16384]; /* room for a few full paths plus dlerror() text */
 static pthread_once_t inner_once = PTHREAD_ONCE_INIT;
+static int pinned;   /* this library stays loaded until the process exits */
+static int no_pool;  /* HYDROFMU_POOL=0: free every instance at fmi2FreeInstance */
 
 /* The GIL functions of the process's Python (PyGILState_STATE is an int-sized enum). */
 static int (*gil_ensure)(void);
@@ -377,9 +400,15 @@ static void *python_main(void *arg) {
     return NULL;
 }
 
-static int python_in_own_thread(const char *self) {
+/* Keep this library loaded until the process exits, whatever the host unloads. */
+static void pin(void) {
     Dl_info info;
-    if (dladdr(&starter, &info) && info.dli_fname) dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    if (!pinned && dladdr(&starter, &info) && info.dli_fname)
+        pinned = dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE) != NULL;
+}
+
+static int python_in_own_thread(const char *self) {
+    pin();
     starter.self = self;
     pthread_t t;
     if (pthread_create(&t, NULL, python_main, NULL) != 0) {
@@ -393,12 +422,40 @@ static int python_in_own_thread(const char *self) {
     return starter.ok;
 }
 
+/* The Python C API behind seen(); all NULL when one is missing (then nothing is pooled). */
+static struct {
+    void *(*SysGetObject)(const char *);
+    int (*SysSetObject)(const char *, void *);
+    void *(*SetNew)(void *);
+    ptrdiff_t (*SetSize)(void *);
+    int (*SetContains)(void *, void *);
+    int (*SetAdd)(void *, void *);
+    int (*SetClear)(void *);
+    void *(*LongFromU64)(unsigned long long);
+    void (*DecRef)(void *);
+    void (*ErrClear)(void);
+} py;
+
+static void find_python_api(void) {
+    const char *names[] = {"PySys_GetObject", "PySys_SetObject", "PySet_New", "PySet_Size", "PySet_Contains",
+                           "PySet_Add", "PySet_Clear", "PyLong_FromUnsignedLongLong", "Py_DecRef", "PyErr_Clear"};
+    void **slots = (void **)&py; /* all members are pointers, in the order of names */
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+        if (!(slots[i] = dlsym(RTLD_DEFAULT, names[i]))) {
+            memset(&py, 0, sizeof py);
+            return;
+        }
+}
+
 static void load_inner(void) {
     char path[4096];
     if (!inner_path(path, sizeof path)) return;
     int (*initialized)(void);
     *(void **)&initialized = dlsym(RTLD_DEFAULT, "Py_IsInitialized");
     if (!(initialized && initialized()) && !python_in_own_thread(path)) return;
+    const char *pool_env = getenv("HYDROFMU_POOL");
+    no_pool = pool_env && !strcmp(pool_env, "0");
+    find_python_api();
     *(void **)&gil_ensure = dlsym(RTLD_DEFAULT, "PyGILState_Ensure");
     *(void **)&gil_release = dlsym(RTLD_DEFAULT, "PyGILState_Release");
     if (!gil_release) gil_ensure = NULL;
@@ -442,15 +499,37 @@ __attribute__((destructor)) static void unload_inner(void) {
 
 /* ---- per-instance data ---- */
 
+struct Shim;
+
+/*
+ * A pythonfmu component and what it was instantiated with.  `cb` (given to pythonfmu,
+ * which keeps a copy) has this Slot as componentEnvironment, so its messages reach the
+ * host instance holding the Slot now (`host`), or nobody while it waits in the pool.
+ */
+typedef struct Slot {
+    fmi2Component inner;          /* pythonfmu's component */
+    fmi2CallbackFunctions cb;     /* its callbacks: shim_logger, calloc/free, environment = this Slot */
+    struct Shim *host;            /* the host instance using it; NULL while pooled */
+    char *key;                    /* pythonfmu's fmi2Instantiate arguments (make_key) ... */
+    size_t keylen;
+    int again;                    /* ... seen before in this process: worth pooling */
+    struct Slot *next;            /* next pooled Slot */
+} Slot;
+
+#define POOL_MAX 8 /* pooled Slots per loaded FMU; more are freed */
+static struct {
+    pthread_mutex_t lock;
+    Slot *idle;
+    int nidle;
+} pool = {PTHREAD_MUTEX_INITIALIZER, NULL, 0};
+
 /*
  * The host's handle.  Everything the host gave fmi2Instantiate that the logger
- * needs is copied here, and `cb` (given to the inner FMU, which keeps a pointer
- * to it) lives as long as the instance.  FMI 2.0 forbids concurrent calls on one
- * instance, so no lock is needed for the logging settings.
+ * needs is copied here.  FMI 2.0 forbids concurrent calls on one instance, so no
+ * lock is needed for the logging settings.
  */
-typedef struct {
-    fmi2Component inner;          /* pythonfmu's component */
-    fmi2CallbackFunctions cb;     /* the inner FMU's callbacks: ours, environment = this Shim */
+typedef struct Shim {
+    Slot *slot;                   /* the pythonfmu component in use */
     fmi2CallbackLogger logger;    /* the host's logger (may be NULL) ... */
     fmi2StepFinished stepFinished;
     fmi2ComponentEnvironment env; /* ... and its componentEnvironment */
@@ -491,7 +570,7 @@ static void shim_logger(fmi2ComponentEnvironment e, fmi2String name, fmi2Status 
                         fmi2String cat, fmi2String msg, ...) {
     static const char *by_status[] = {"logStatusOK", "logStatusWarning", "logStatusDiscard",
                                       "logStatusError", "logStatusFatal", "logStatusPending"};
-    Shim *s = e;
+    Shim *s = e ? ((Slot *)e)->host : NULL;
     if (s && st > s->worst && st <= fmi2Fatal) s->worst = st;
     /* never hand the host a NULL string (pythonfmu reports exceptions with no category) */
     if (!cat) cat = st >= fmi2OK && st <= fmi2Pending ? by_status[st] : "";
@@ -521,7 +600,7 @@ static void shim_logger(fmi2ComponentEnvironment e, fmi2String name, fmi2Status 
 }
 
 static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
-    const Shim *s = e;
+    const Shim *s = e ? ((Slot *)e)->host : NULL;
     if (s && s->stepFinished) s->stepFinished(s->env, st);
 }
 
@@ -530,7 +609,7 @@ static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
     EXPORT fmi2Status fmi2##name params {                 \
         if (!ready() || !c) return fmi2Error;             \
         Shim *s_ = c;                                     \
-        c = s_->inner;                                    \
+        c = s_->slot->inner;                              \
         s_->worst = fmi2OK;                               \
         GIL_TAKE;                                         \
         fmi2Status st_ = inner.name args;                 \
@@ -550,6 +629,107 @@ EXPORT const char *fmi2GetVersion(void) {
     return "2.0";
 }
 
+/* pythonfmu's fmi2Instantiate arguments as one block: name, GUID, resources, type, visible. */
+static char *make_key(fmi2String name, fmi2Type type, fmi2String guid, fmi2String res,
+                      fmi2Boolean visible, size_t *len) {
+    const char *parts[] = {name ? name : "", guid ? guid : "", res ? res : ""};
+    size_t n = 2;
+    for (int i = 0; i < 3; i++) n += strlen(parts[i]) + 1;
+    char *key = malloc(n), *q = key;
+    if (!key) return NULL;
+    for (int i = 0; i < 3; i++) q = stpcpy(q, parts[i]) + 1;
+    *q++ = (char)('0' + type);
+    *q = (char)(visible ? '1' : '0');
+    *len = n;
+    return key;
+}
+
+static uint64_t hash(const char *p, size_t n) { /* FNV-1a */
+    uint64_t h = 1469598103934665603u;
+    while (n--) h = (h ^ (unsigned char)*p++) * 1099511628211u;
+    return h;
+}
+
+#define SEEN "_hydrofmu_shim_instances"
+#define SEEN_MAX 1024
+
+/*
+ * Was an instance with this key instantiated before in this process (through any copy of
+ * the shim, also one unloaded since)?  Notes the key.  Call with the GIL held.
+ */
+static int seen(const char *key, size_t len) {
+    if (!py.DecRef) return 0;
+    void *set = py.SysGetObject(SEEN); /* borrowed */
+    if (!set || py.SetSize(set) < 0) {
+        py.ErrClear();
+        if (!(set = py.SetNew(NULL)) || py.SysSetObject(SEEN, set) < 0) {
+            if (set) py.DecRef(set);
+            py.ErrClear();
+            return 0;
+        }
+        py.DecRef(set); /* sys holds it */
+    }
+    void *h = py.LongFromU64(hash(key, len));
+    int found = h && py.SetContains(set, h) == 1;
+    if (h && !found) {
+        if (py.SetSize(set) >= SEEN_MAX) py.SetClear(set);
+        py.SetAdd(set, h);
+    }
+    if (h) py.DecRef(h);
+    py.ErrClear();
+    return found;
+}
+
+/* A pooled Slot with this key, taken out of the pool; else NULL. */
+static Slot *take(const char *key, size_t len) {
+    pthread_mutex_lock(&pool.lock);
+    Slot **p = &pool.idle;
+    while (*p && ((*p)->keylen != len || memcmp((*p)->key, key, len))) p = &(*p)->next;
+    Slot *slot = *p;
+    if (slot) {
+        *p = slot->next;
+        pool.nidle--;
+    }
+    pthread_mutex_unlock(&pool.lock);
+    return slot;
+}
+
+/*
+ * Deliver the log messages pythonfmu still holds (a slave that logged in __init__, freed
+ * before any other call) with a call that reads no variable: pythonfmu 0.7 crashes in
+ * fmi2FreeInstance when messages are queued.  Call with the GIL held.
+ */
+static void flush(Slot *slot) {
+    inner.GetReal(slot->inner, NULL, 0, NULL);
+}
+
+/* Free a Slot and its pythonfmu component. */
+static void drop(Slot *slot) {
+    if (slot->inner) {
+        GIL_TAKE;
+        flush(slot);
+        inner.FreeInstance(slot->inner);
+        GIL_GIVE;
+    }
+    free(slot->key);
+    free(slot);
+}
+
+/* A pooled Slot made ready for `s` by pythonfmu's fmi2Reset (a new Python slave); NULL if none. */
+static Slot *reuse(Shim *s, const char *key, size_t len) {
+    Slot *slot = take(key, len);
+    if (!slot) return NULL;
+    slot->host = s;
+    s->worst = fmi2OK;
+    GIL_TAKE;
+    fmi2Status st = inner.Reset(slot->inner);
+    GIL_GIVE;
+    if (truthful(s, st) <= fmi2Warning) return slot;
+    slot->host = NULL;
+    drop(slot);
+    return NULL;
+}
+
 EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
                                      fmi2String res, const fmi2CallbackFunctions *cb,
                                      fmi2Boolean visible, fmi2Boolean logging) {
@@ -563,7 +743,10 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     int host_mem = cb && cb->allocateMemory && cb->freeMemory;
     void *(*alloc)(size_t, size_t) = host_mem ? cb->allocateMemory : calloc;
     Shim *s = alloc(1, sizeof *s);
-    if (!s) {
+    size_t len = 0;
+    char *key = s ? make_key(name, type, guid, res, visible, &len) : NULL;
+    if (!key) {
+        if (s) (host_mem ? cb->freeMemory : free)(s);
         if (log) log(env, name ? name : "", fmi2Error, "logStatusError", "hydrofmu shim: out of memory");
         return NULL;
     }
@@ -574,18 +757,32 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     s->alloc = alloc;
     s->release = host_mem ? cb->freeMemory : free;
     s->logging = logging != 0;
+    s->slot = reuse(s, key, len);
+    if (s->slot) {
+        free(key);
+        return s;
+    }
+    Slot *slot = calloc(1, sizeof *slot);
+    if (!slot) {
+        free(key);
+        s->release(s);
+        if (log) log(env, name ? name : "", fmi2Error, "logStatusError", "hydrofmu shim: out of memory");
+        return NULL;
+    }
     /* the members are const: build the struct, then copy it in */
-    fmi2CallbackFunctions mine = {shim_logger,
-                                  cb ? cb->allocateMemory : NULL,
-                                  cb ? cb->freeMemory : NULL,
-                                  s->stepFinished ? shim_step_finished : NULL,
-                                  s};
-    memcpy(&s->cb, &mine, sizeof mine);
+    fmi2CallbackFunctions mine = {shim_logger, calloc, free, shim_step_finished, slot};
+    memcpy(&slot->cb, &mine, sizeof mine);
+    slot->key = key;
+    slot->keylen = len;
+    slot->host = s;
+    s->slot = slot;
     /* inner logging always on: the filtering is done in shim_logger */
     GIL_TAKE;
-    s->inner = inner.Instantiate(name, type, guid, res, &s->cb, visible, 1);
+    slot->again = seen(key, len);
+    slot->inner = inner.Instantiate(name, type, guid, res, &slot->cb, visible, 1);
     GIL_GIVE;
-    if (!s->inner) {
+    if (!slot->inner) {
+        drop(slot);
         s->release(s);
         return NULL;
     }
@@ -595,10 +792,25 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
 EXPORT void fmi2FreeInstance(fmi2Component c) {
     Shim *s = c;
     if (!s) return;
+    Slot *slot = s->slot;
     if (ready()) { /* may still log: s stays valid until after */
         GIL_TAKE;
-        inner.FreeInstance(s->inner);
+        flush(slot); /* to this host, also when the Slot is pooled */
         GIL_GIVE;
+        int keep = 0;
+        if (slot->again && !no_pool) {
+            pin(); /* pooled components call back into this library */
+            pthread_mutex_lock(&pool.lock);
+            keep = pinned && pool.nidle < POOL_MAX;
+            if (keep) {
+                slot->host = NULL;
+                slot->next = pool.idle;
+                pool.idle = slot;
+                pool.nidle++;
+            }
+            pthread_mutex_unlock(&pool.lock);
+        }
+        if (!keep) drop(slot);
     }
     if (s->cats) s->release(s->cats);
     s->release(s);
@@ -633,7 +845,7 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n,
     s->ncat = n;
     s->logging = on != 0;
     GIL_TAKE;
-    fmi2Status st = inner.SetDebugLogging(s->inner, 1, 0, NULL);
+    fmi2Status st = inner.SetDebugLogging(s->slot->inner, 1, 0, NULL);
     GIL_GIVE;
     return st;
 }
@@ -643,7 +855,7 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
     Shim *sh = c;
     sh->worst = fmi2OK;
     GIL_TAKE;
-    fmi2Status s = inner.DoStep(sh->inner, t, h, noPrior);
+    fmi2Status s = inner.DoStep(sh->slot->inner, t, h, noPrior);
     GIL_GIVE;
     return truthful(sh, s == fmi2Discard ? fmi2Error : s);
 }

@@ -8,7 +8,10 @@ on and passes warnings and errors to the host always, other messages only when t
 host's logging is on for their category.  Everything else is forwarded unchanged.
 In a host process without Python (a native FMI host such as libcosim's ``cosim``) the
 shim starts the interpreter recorded at build time (``$HYDROFMU_PYTHON`` overrides it)
-before loading pythonfmu's binary; see shim.c.  Layout inside the FMU after
+before loading pythonfmu's binary.  pythonfmu 0.7 leaks ~1.2 kB at every fmi2Instantiate,
+so the shim pools freed instances and hands them back, after fmi2Reset, to an
+fmi2Instantiate with the same arguments (HYDROFMU_POOL=0 turns that off); see shim.c.
+Layout inside the FMU after
 ``install_shim``::
 
     binaries/linux64/<id>.so              the shim (compiled from shim.c)
