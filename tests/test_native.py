@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from conftest import MODELS
-from hydrofmu.bench.robust import FLAT_KB, STEP_KB, growth
+from hydrofmu.bench.robust import ARENA_KB, FLAT_KB, growth
 
 pytest.importorskip("libcosimpy")
 NATIVE = Path(__file__).with_name("native")
@@ -346,14 +346,14 @@ def cycled(hosts, unzipped, cycles, every, inputs, outputs, steps=5, dt=0.1):
 def test_ten_thousand_instantiate_free_cycles_at_flat_memory(hosts, load_fmu):
     """10⁴ fmi2Instantiate … fmi2FreeInstance cycles of one load FMU in a native host, each
     initialised and stepped once: resident memory is flat over the last 9000 (bench/robust.py:
-    FLAT_KB and STEP_KB, and what they rest on; without the pool it grows 12 MB).  The
+    FLAT_KB and ARENA_KB, and what they rest on; without the pool it grows 12 MB).  The
     run's instance then (a pooled one, reset) steps bit for bit like a fresh process's."""
     vr = load_fmu[3]
     inputs = {vr["position[1]"]: 2.0, vr["position[2]"]: -1.0, vr["velocity[1]"]: 0.3, vr["velocity[6]"]: 0.01}
     outputs = [vr[f"force[{i}]"] for i in range(1, 7)]
     rss, got, fresh = cycled(hosts, load_fmu, 10_000, 1000, inputs, outputs)
-    steady, step = growth([rss[k] for k in sorted(rss)])
-    assert steady < FLAT_KB and step < STEP_KB, rss
+    steady, total = growth([rss[k] for k in sorted(rss)])
+    assert steady < FLAT_KB and total < ARENA_KB, rss
     assert got == fresh and len(got) == 30
 
 
@@ -365,8 +365,8 @@ def test_dynamics_fmu_cycles_at_flat_memory(hosts, scenes, tmp_path):
     inputs = {vr["force[1]"]: 1e3, vr["force[3]"]: -5e2, vr["force[5]"]: 2e3}
     outputs = [vr[f"position[{i}]"] for i in range(1, 4)] + [vr[f"attitude[{i}]"] for i in range(1, 4)]
     rss, got, fresh = cycled(hosts, dyn, 3000, 500, inputs, outputs)
-    steady, step = growth([rss[k] for k in sorted(rss)])
-    assert steady < FLAT_KB and step < STEP_KB, rss
+    steady, total = growth([rss[k] for k in sorted(rss)])
+    assert steady < FLAT_KB and total < ARENA_KB, rss
     assert got == fresh and len(got) == 30 and got[0, 5, outputs[0]] != 0.0
 
 

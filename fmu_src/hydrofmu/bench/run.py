@@ -331,13 +331,13 @@ def part_robust(out, quick):
              "growth_kB": c["growth_kB"], "steady_kB": robust.growth(c["rss_kB"])[0],
              "kB_per_cycle": c["kB_per_cycle"], "cycle_s": c["cycle_s"]} for p, c in (("off", off), ("on", on))]
     write_csv(out / "robust.csv", rows)
-    steady, step = robust.growth(on["rss_kB"])
-    flat = steady < robust.FLAT_KB and step < robust.STEP_KB
+    steady, total = robust.growth(on["rss_kB"])
+    flat = steady < robust.FLAT_KB and total < robust.ARENA_KB
     return [f"one bad number near the end of a {r['megabytes']:.0f} MB SIMO deck: reported in {r['bad_s']:.2f} s, "
             f"the good deck reads in {r['good_s']:.2f} s (ratio {r['ratio']:.2f}, best of 2, side by side)",
             f"{cycles} fmi2Instantiate/fmi2FreeInstance cycles of a load FMU through fmpy after 1000 of warm-up, "
             f"resident memory: {on['growth_kB']:.0f} kB ({on['kB_per_cycle']:.3f} kB per cycle; "
-            f"{steady:.0f} kB besides its largest step of {step:.0f} kB: {'flat' if flat else 'NOT flat'}) "
+            f"steady part {steady:.0f} kB: {'flat' if flat else 'NOT flat'}) "
             f"with the shim's instance pool, {off['growth_kB']:.0f} kB ({off['kB_per_cycle']:.2f} kB per cycle) "
             f"without (HYDROFMU_POOL=0); {1e3 * on['cycle_s']:.1f} ms against {1e3 * off['cycle_s']:.1f} ms "
             f"per cycle (×{off['cycle_s'] / on['cycle_s']:.1f})"]
