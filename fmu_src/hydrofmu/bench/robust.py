@@ -2,6 +2,7 @@
 of a big deck, against reading the same deck without it (both ways linear, so the ratio
 should stay near 1 whatever the size), and resident memory over fmi2Instantiate/
 fmi2FreeInstance cycles with and without the shim's instance pool."""
+import gc
 import os
 import shutil
 import time
@@ -73,7 +74,9 @@ def instantiate_cycles(fmu, cycles=10_000, warmup=1000, every=1000, pool=True):
     and unloads the library every time), after ``warmup`` pairs; ``pool=False`` runs a copy
     of the FMU with the shim's instance pool off (HYDROFMU_POOL=0).  Returns a dict: resident
     memory growth over the measured cycles [kB] and per cycle, seconds per cycle, and the
-    resident memory [kB] after the warm-up and then every ``every`` cycles."""
+    resident memory [kB] after the warm-up and then every ``every`` cycles, each sample after
+    a full garbage collection: fmpy's FMU2Slave and the slave objects hold reference cycles,
+    which a process with a large heap (a test session) collects only now and then."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -92,11 +95,11 @@ def instantiate_cycles(fmu, cycles=10_000, warmup=1000, every=1000, pool=True):
     try:
         for _ in range(warmup):
             cycle()
-        rss, t0 = [_rss() / 1e3], time.perf_counter()
+        rss, t0 = [_rss()], time.perf_counter()
         for k in range(1, cycles + 1):
             cycle()
             if k % every == 0 or k == cycles:
-                rss.append(_rss() / 1e3)
+                rss.append(_rss())
         seconds = time.perf_counter() - t0
     finally:
         if saved is None:
@@ -117,5 +120,7 @@ def growth(rss):
 
 
 def _rss():
+    """Resident memory [kB] after a full garbage collection."""
+    gc.collect()
     with open("/proc/self/statm") as f:
-        return int(f.read().split()[1]) * 4096
+        return int(f.read().split()[1]) * 4096 / 1e3
