@@ -29,6 +29,8 @@ from fmpy.fmi2 import (  # noqa: E402
     fmi2Error,
     fmi2OK,
 )
+
+fmi2LastSuccessfulTime = 2  # fmi2StatusKind
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from hydrofmu.fmi import shim  # noqa: E402
@@ -439,8 +441,8 @@ class Cycler:
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
 
     def counts(self):
-        m = sys.modules[self.module]
-        return m.RUNS, m.INITS
+        m = sys.modules.get(self.module)
+        return getattr(m, "RUNS", 0), getattr(m, "INITS", 0)
 
     def instantiate(self, name, log=None, env=0, logging=False):
         s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.folder,
@@ -477,14 +479,29 @@ def test_pool_hands_back_a_freed_instance_reset(fmus, tmp_path):
     """The same instance instantiated and freed over and over: the first two are new, the
     shim pools the second (an instance seen before) and hands it back from then on, after
     fmi2Reset (a new slave object, the script not run again), in a fresh state (one step:
-    steps = 1); another instance name is not served from the pool."""
+    steps = 1; no last successful time before a step, also after a host's fmi2Reset);
+    another instance name is not served from the pool."""
     c = Cycler(fmus[1], tmp_path / "copy")
     runs, inits = c.counts()
     for k in range(6):
         assert c.cycle("a", x=float(k)) == (2.0 * k, 1.0)
     assert c.counts() == (runs + 2, inits + 6)
+    s = c.instantiate("a")   # pythonfmu's last successful time: none yet, as for a new one
+    try:
+        last = c_double(0.0)
+        assert s.dll.fmi2GetRealStatus(s.component, fmi2LastSuccessfulTime, byref(last)) == fmi2OK
+        assert math.isnan(last.value)
+        c.step(s, 1.0)
+        assert s.dll.fmi2GetRealStatus(s.component, fmi2LastSuccessfulTime, byref(last)) == fmi2OK
+        assert last.value == 0.1
+        s.reset()
+        assert s.dll.fmi2GetRealStatus(s.component, fmi2LastSuccessfulTime, byref(last)) == fmi2OK
+        assert math.isnan(last.value)
+    finally:
+        s.freeInstance()
+    assert c.counts() == (runs + 2, inits + 8)   # reused, then the host's fmi2Reset
     assert c.cycle("b", x=1.0) == (2.0, 1.0)
-    assert c.counts() == (runs + 3, inits + 7)
+    assert c.counts() == (runs + 3, inits + 9)
 
 
 def test_pooled_instance_takes_the_new_hosts_callbacks(fmus, tmp_path):
@@ -525,7 +542,7 @@ def test_pool_off(fmus, tmp_path, monkeypatch):
     """HYDROFMU_POOL=0: every fmi2Instantiate makes a new instance."""
     monkeypatch.setenv("HYDROFMU_POOL", "0")
     c = Cycler(fmus[1], tmp_path / "copy")
-    runs, _ = c.counts() if c.module in sys.modules else (0, 0)
+    runs, _ = c.counts()
     for _ in range(4):
         c.cycle("a")
     assert c.counts()[0] == runs + 4

@@ -69,6 +69,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 
 /* ---- FMI 2.0 types (same layout as fmi2TypesPlatform.h / fmi2FunctionTypes.h) ---- */
 typedef void *fmi2Component;
@@ -116,7 +117,6 @@ typedef const fmi2ValueReference *VRs;
     X(EnterInitializationMode, (fmi2Component c), (c)) \
     X(ExitInitializationMode, (fmi2Component c), (c)) \
     X(Terminate, (fmi2Component c), (c)) \
-    X(Reset, (fmi2Component c), (c)) \
     X(GetReal, (fmi2Component c, VRs vr, size_t n, fmi2Real v[]), (c, vr, n, v)) \
     X(GetInteger, (fmi2Component c, VRs vr, size_t n, fmi2Integer v[]), (c, vr, n, v)) \
     X(GetBoolean, (fmi2Component c, VRs vr, size_t n, fmi2Boolean v[]), (c, vr, n, v)) \
@@ -136,7 +136,6 @@ typedef const fmi2ValueReference *VRs;
     X(GetRealOutputDerivatives, (fmi2Component c, VRs vr, size_t n, const fmi2Integer ord[], fmi2Real v[]), (c, vr, n, ord, v)) \
     X(CancelStep, (fmi2Component c), (c)) \
     X(GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v)) \
-    X(GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v)) \
     X(GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v)) \
     X(GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v)) \
     X(GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))
@@ -148,7 +147,9 @@ typedef const fmi2ValueReference *VRs;
     X(fmi2Component, Instantiate, (fmi2String name, fmi2Type type, fmi2String guid, fmi2String res, const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean logging)) \
     X(fmi2Status, SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[])) \
     X(void, FreeInstance, (fmi2Component c)) \
-    X(fmi2Status, DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior))
+    X(fmi2Status, DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior)) \
+    X(fmi2Status, Reset, (fmi2Component c)) \
+    X(fmi2Status, GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v))
 
 /* Table of pointers into the inner library, one typed member per function. */
 static struct {
@@ -539,6 +540,7 @@ typedef struct Shim {
     size_t ncat;                  /* host's categories; none = all */
     char **cats;                  /* one block: ncat pointers, then the strings */
     fmi2Status worst;             /* worst status logged during the current call */
+    int stepped;                  /* a step succeeded since fmi2Instantiate or fmi2Reset */
 } Shim;
 
 /*
@@ -857,5 +859,35 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
     GIL_TAKE;
     fmi2Status s = inner.DoStep(sh->slot->inner, t, h, noPrior);
     GIL_GIVE;
+    sh->stepped |= s == fmi2OK || s == fmi2Discard; /* when pythonfmu records the time */
     return truthful(sh, s == fmi2Discard ? fmi2Error : s);
+}
+
+EXPORT fmi2Status fmi2Reset(fmi2Component c) {
+    if (!ready() || !c) return fmi2Error;
+    Shim *sh = c;
+    sh->worst = fmi2OK;
+    sh->stepped = 0;
+    GIL_TAKE;
+    fmi2Status s = inner.Reset(sh->slot->inner);
+    GIL_GIVE;
+    return truthful(sh, s);
+}
+
+/*
+ * pythonfmu keeps the last successful time through fmi2Reset, and so from a pooled
+ * instance's last use: before a step it is NaN, as pythonfmu says for a new instance.
+ */
+EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v) {
+    if (!ready() || !c) return fmi2Error;
+    Shim *sh = c;
+    if (k == fmi2LastSuccessfulTime && !sh->stepped && v) {
+        *v = NAN;
+        return fmi2OK;
+    }
+    sh->worst = fmi2OK;
+    GIL_TAKE;
+    fmi2Status s = inner.GetRealStatus(sh->slot->inner, k, v);
+    GIL_GIVE;
+    return truthful(sh, s);
 }
