@@ -42,7 +42,7 @@ def test_scene_knobs_win_and_are_reported(tmp_path):
     result = run(folder, step=0.05, progress=False)
     s = result.settings
     assert (s["preset"], s["step"], s["algorithm"], s["load_hold"]) == ("screening", 0.05, "gauss-seidel", "linear")
-    assert "step (run)" in s["set"] and s["couplings"]["C1_2"]["method"] == "convolution"
+    assert s["set"] == ["stop", "step (run)"] and s["couplings"]["C1_2"]["method"] == "convolution"
     line = describe(s)
     assert line.startswith("preset screening: step 0.05 s, gauss-seidel, linear load hold")
     assert "C1_2: convolution (set: method)" in line

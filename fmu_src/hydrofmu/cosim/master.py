@@ -44,7 +44,8 @@ def run_settings(manifest, step=None, algorithm=None, stop=None):
     for key, value in (("step", step), ("algorithm", algorithm), ("stop", stop)):
         if value is not None and value != out[key]:
             out[key] = value
-            out["set"].append(f"{key} (run)")
+            # the run's value replaces the scene's in the list too ("stop (run)", not "stop, stop (run)")
+            out["set"] = [k for k in out["set"] if k != key] + [f"{key} (run)"]
     out["couplings"] = manifest.get("couplings", {})
     if out["algorithm"] == "ecco":
         from ..scene import ECCO_DEFAULTS
