@@ -244,3 +244,68 @@ def test_zero_and_empty_kernels():
         Convolution([1.0, 0.5], 0.1).advance(0.0, [1.0])
     with pytest.raises(ValueError):
         StateSpace([1.0, 0.5, 0.2], 0.1).advance(-1.0, [1.0])
+
+
+# ---------------------------------------------------------------- stacked evaluators, peeks
+
+@pytest.mark.parametrize("dense", [64, 0])   # a step as one real product / on the complex modes
+def test_stack_equals_its_parts(dense, monkeypatch):
+    """StateSpace.stack of two evaluators taken mid-run (and an empty one) gives, step for
+    step, the parts' own peeks and loads (to round-off: the same sums in one product), under
+    variable steps; its state restores into a new stack of the same parts."""
+    monkeypatch.setattr(memory, "DENSE_STATES", dense)
+    rng = np.random.default_rng(11)
+    timdel = 0.2
+    t = timdel * np.arange(40)
+    k1 = {(0, 0): np.exp(-0.3 * t), (1, 2): np.exp(-0.5 * t) * np.cos(t), (0, 1): -np.exp(-t)}
+    k2 = {(0, 1): 2.0 * np.exp(-0.2 * t) * np.sin(1.5 * t), (0, 0): np.exp(-t)}
+
+    def parts():
+        return [StateSpace(k1, timdel, shape=(2, 3), tol=1e-4), StateSpace({}, timdel, shape=(1, 1)),
+                StateSpace(k2, timdel, shape=(1, 2), tol=1e-4)]
+
+    steps, vels = rng.uniform(0.02, 0.4, 80), rng.normal(size=(80, 6))
+    sep = parts()
+    for dt, v in zip(steps[:20], vels[:20]):                # mid-run: non-zero states
+        for p, s in zip(sep, (v[:3], v[3:4], v[4:])):
+            p.advance(dt, s)
+    copies = parts()
+    for c, p in zip(copies, sep):
+        c.set_state(p.state())
+    stack = StateSpace.stack(copies)
+    assert stack.shape == (4, 6) and stack.order == sum(p.order for p in sep)
+    assert stack.fits[(3, 5)] is copies[2].fits[(0, 1)]
+    for k, (dt, v) in enumerate(zip(steps[20:], vels[20:])):
+        if k == 30:                                          # a saved state continues exactly
+            again = StateSpace.stack(parts())
+            again.set_state(json.loads(json.dumps(stack.state())))
+            stack = again
+        split = (v[:3], v[3:4], v[4:])
+        want_peek = np.concatenate([p.peek(dt, s) for p, s in zip(sep, split)])
+        np.testing.assert_allclose(stack.peek(dt, v), want_peek, rtol=1e-12, atol=1e-12)
+        want = np.concatenate([p.advance(dt, s) for p, s in zip(sep, split)])
+        got = stack.advance(dt, v, peeked=True) if k % 2 else stack.advance(dt, v)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+        assert np.abs(want).max() > 1e-3
+
+
+@pytest.mark.parametrize("make", [
+    lambda k, d: Convolution(k, d, shape=(1, 2)),
+    lambda k, d: StateSpace(k, d, shape=(1, 2), tol=1e-4),
+])
+def test_advance_of_the_last_peek_equals_a_fresh_step(make):
+    """advance(dt, v, peeked=True) takes the last peek as it is (the caller vouches for its
+    arguments) and equals advance on a twin that never peeked; with no peek pending (the
+    first step, or after a restored state) it computes the step from its own arguments."""
+    timdel = 0.1
+    t = timdel * np.arange(50)
+    kernels = {(0, 0): np.exp(-0.4 * t), (0, 1): np.exp(-0.2 * t) * np.cos(2 * t)}
+    a, b = make(kernels, timdel), make(kernels, timdel)
+    rng = np.random.default_rng(3)
+    for k, (dt, v) in enumerate(zip(rng.uniform(0.03, 0.3, 40), rng.normal(size=(40, 2)))):
+        if k % 3:
+            a.peek(dt, v)
+        if k == 20:
+            a.set_state(a.state())   # drops the peek
+        np.testing.assert_array_equal(a.advance(dt, v, peeked=True), b.advance(dt, v))
+    assert a.state() == b.state()

@@ -74,6 +74,7 @@ from ..physics import quiet
 from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
+from ..physics.memory import StateSpace
 from ..physics.rigid_body import CoupledBodies, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
@@ -128,6 +129,7 @@ class ArraySlave(Fmi2Slave):
         self._inputs, self._params, self._outputs = [], [], []   # value references by causality
         self.running = False    # after exit_initialization_mode: parameters are fixed
         self.next_time = None   # the communication point the next fmi2DoStep must start from
+        self.checked = False    # outputs known finite (set by an evaluation that checked them all)
         self._finite_idx = {}   # check_finite: id of a list of input slices -> (it, its value indices)
 
     # -- registration ------------------------------------------------------------------
@@ -292,6 +294,8 @@ class ArraySlave(Fmi2Slave):
     def check_outputs(self, vrs=None):
         """Log an error naming the first non-finite value among ``vrs`` (default: every
         output); True when all are finite."""
+        if vrs is None and self.checked:
+            return True
         vrs = self.output_vrs if vrs is None else vrs
         out = self.values[vrs]
         if _finite(out.tolist()) or np.isfinite(out).all():
@@ -391,7 +395,7 @@ class ArraySlave(Fmi2Slave):
         self.values[:] = state["values"]
         self.set_physics_state(state["physics"])
         self.next_time, self.running = state["next_time"], state["running"]
-        self.stale = True
+        self.stale, self.checked = True, False
         self.error = None
 
     @staticmethod
@@ -440,7 +444,7 @@ class LoadSlave(ArraySlave):
             out = self.add_vector(f"{c.name}.force", 6, Out, LIN_ROT["force"], None,
                                   f"hydrodynamic coupling {c.name} (from {src}'s motion)")
             self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
-                                   "mass": c.mass, "memory": None})
+                                   "mass": c.mass})
             inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
         self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
                                      "total load on the body, global axes, moments about the reference point")
@@ -460,18 +464,31 @@ class LoadSlave(ArraySlave):
             for c in self.couplings:
                 self.add_mass_export(f"{c['cfg'].name}.mass_matrix", c["mass"])
         self.finish_registration()
+        self.memories = []   # set up by start_physics
         self.stale = True
 
     def start_physics(self):
-        for c in self.couplings:
+        """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
+        the velocity inputs it reads, the rows of the output block it gives)].  The state-space
+        ones are stacked into one evaluator (one product a step for all of them); any other
+        (convolution) is one of its own."""
+        first = 1 + len(self.loads.effects)   # row of the first coupling in the output block
+        stack, self.memories = [], []
+        for k, c in enumerate(self.couplings):
             side = c["cfg"]
             if side.coupling.kernels:
                 v0 = self.values[c["velocity"]].copy()
-                c["memory"] = FeedthroughMemory(side.coupling.model(v0_a=v0, v0_b=v0).memory[side.side])
+                ev = side.coupling.model(v0_a=v0, v0_b=v0).memory[side.side]
+                (stack if isinstance(ev, StateSpace) else self.memories).append(([ev], [k]))
+        if stack:
+            self.memories.append(([ev for evs, _ in stack for ev in evs], [k for _, ks in stack for k in ks]))
+        self.memories = [(FeedthroughMemory(evs[0] if len(evs) == 1 else StateSpace.stack(evs)),
+                          _joined([self.couplings[k]["velocity"] for k in ks]), _joined([first + k for k in ks]))
+                         for evs, ks in self.memories]
         self.stale = True
 
     def evaluate(self):
-        self.stale = False
+        self.stale = self.checked = False
         if not self.check_finite(self.inputs):
             return
         v = self.values
@@ -479,27 +496,29 @@ class LoadSlave(ArraySlave):
         out = np.zeros((1 + ne + len(self.couplings), 6))   # total, effects, couplings
         if ne:
             out[1:1 + ne] = self.loads.effect_loads(self.motion(self.motion_inputs), self.env())
+        for mem, vel, rows in self.memories:
+            out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, c in enumerate(self.couplings, 1 + ne):
-            if c["memory"] is not None:
-                out[k] = c["memory"].force(v[c["velocity"]])
             if c["acceleration"] is not None:
                 out[k] -= c["mass"] @ v[c["acceleration"]]
         out[0] = self._load_total @ out
         v[self._load_out] = out.ravel()
+        # the total sums every other output: if it is finite, so are they (an overflow of the
+        # sum only sends do_step to check them one by one)
+        self.checked = _finite(out[0].tolist())
 
     def step_physics(self, t, dt):
-        for c in self.couplings:
-            if c["memory"] is not None:
-                c["memory"].commit(self.values[c["velocity"]], dt)
+        # not stale: the inputs are those of the last evaluation, whose peek the step takes
+        for mem, vel, _ in self.memories:
+            mem.commit(self.values[vel], dt, peeked=not self.stale)
         self.stale = bool(self.couplings)  # memory outputs move with time
 
     def physics_state(self):
-        return {"memory": [None if c["memory"] is None else c["memory"].state() for c in self.couplings]}
+        return {"memory": [mem.state() for mem, _, _ in self.memories]}
 
     def set_physics_state(self, state):
-        for c, s in zip(self.couplings, state["memory"]):
-            if s is not None:
-                c["memory"].set_state(s)
+        for (mem, _, _), s in zip(self.memories, state["memory"]):
+            mem.set_state(s)
 
 
 class DynamicsSlave(ArraySlave):
@@ -677,12 +696,14 @@ class FeedthroughMemory:
             return np.asarray(self.ev.force, dtype=float).copy()
         return self.ev.peek(self.pending, v)
 
-    def commit(self, v, dt_next):
+    def commit(self, v, dt_next, peeked=False):
         """Close the pending interval at velocity v; the next one is dt_next long.  At the
         first step v is the velocity at t0: an input set after initialization and before the
-        first fmi2DoStep is the value at t0 (FMI 2.0), so it starts the history."""
+        first fmi2DoStep is the value at t0 (FMI 2.0), so it starts the history.
+        ``peeked``: v is the velocity of the last ``force`` (the caller's inputs have not
+        changed since), whose evaluation the interval then keeps without comparing."""
         if self.pending > 0.0:
-            self.ev.advance(self.pending, v)
+            self.ev.advance(self.pending, v, peeked)
         else:
             self.ev.restart(v)
         self.pending = float(dt_next)
@@ -693,6 +714,12 @@ class FeedthroughMemory:
     def set_state(self, state):
         self.pending = state["pending"]
         self.ev.set_state(state["ev"])
+
+
+def _joined(indices):
+    """A slice for consecutive indices (slices or ints), else an index array."""
+    idx = np.r_[tuple(indices)]
+    return slice(int(idx[0]), int(idx[-1]) + 1) if idx.size and (np.diff(idx) == 1).all() else idx
 
 
 def _plain(obj):

@@ -133,10 +133,11 @@ class Convolution:
         self._peeked = (float(dt), self._v[self._hi].copy(), force, lo)
         return force.copy()
 
-    def advance(self, dt, v_new):
-        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+    def advance(self, dt, v_new, peeked=False):
+        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt).
+        ``peeked``: as for ``StateSpace.advance``."""
         p = self._peeked
-        if p is None or p[0] != dt or p[1].tolist() != np.asarray(v_new).tolist():   # (cheaper on lists)
+        if p is None or not peeked and (p[0] != dt or p[1].tolist() != np.asarray(v_new).tolist()):   # (lists: cheaper)
             self.peek(dt, v_new)
         _, _, self.force, self._lo = self._peeked
         self._hi += 1
@@ -401,9 +402,13 @@ class StateSpace:
                 inp.append(j)
                 out.append(i)
                 k += 2 if om else 1
-        self._mu, self._gam = np.array(mu, complex), np.array(gam, complex)
-        self._inp, self._out = np.array(inp, int), np.array(out, int)
         self.order = sum(f.order for f in self.fits.values())   # real states
+        self._set_modes(np.array(mu, complex), np.array(gam, complex), np.array(inp, int), np.array(out, int))
+        self._v = _start(self.shape, v0)
+
+    def _set_modes(self, mu, gam, inp, out):
+        """Set the modes (μ, γ, input and output index of each) and a zero state."""
+        self._mu, self._gam, self._inp, self._out = mu, gam, inp, out
         self._z = np.zeros(len(mu), complex)
         # Products on real views of the complex modal state (z as [Re z₀, Im z₀, Re z₁, …]),
         # so each step is two small real matrix products: F = −Re(Γ·z) = gain·z_real.
@@ -412,11 +417,34 @@ class StateSpace:
         self._gain[self._out, 2 * np.arange(m)] = -self._gam.real
         self._gain[self._out, 2 * np.arange(m) + 1] = self._gam.imag
         self._u = np.zeros(2 * self.shape[1])       # [v_old, v_new]
-        self._v = _start(self.shape, v0)
         self._cache = OrderedDict()
         self._last_dt, self._last = None, None
         self._peeked = None
         self.force = np.zeros(self.shape[0])
+
+    @classmethod
+    def stack(cls, parts):
+        """One evaluator for several independent ones side by side, each taken at its current
+        state: inputs and outputs concatenated in the order given (the velocities of part k
+        follow those of parts 0…k−1, likewise its loads).  A step of the stack is one product
+        for all of them (per-call cost paid once); its loads equal the parts' own to round-off
+        (the same sums, as rows of one product).  ``fits`` keys are offset accordingly."""
+        self = cls.__new__(cls)
+        fits, at_out, at_in = {}, [0], [0]
+        for p in parts:
+            fits.update({(i + at_out[-1], j + at_in[-1]): f for (i, j), f in p.fits.items()})
+            at_out.append(at_out[-1] + p.shape[0])
+            at_in.append(at_in[-1] + p.shape[1])
+        self.shape, self.fits = (at_out[-1], at_in[-1]), fits
+        self.order = sum(p.order for p in parts)
+        join = lambda arrays, dtype: np.concatenate([np.zeros(0, dtype)] + list(arrays))   # noqa: E731
+        self._set_modes(join((p._mu for p in parts), complex), join((p._gam for p in parts), complex),
+                    join((p._inp + a for p, a in zip(parts, at_in)), int),
+                    join((p._out + a for p, a in zip(parts, at_out)), int))
+        self._z = join((p._z for p in parts), complex)
+        self._v = join((p._v for p in parts), float)
+        self.force = join((p.force for p in parts), float)
+        return self
 
     @property
     def velocity(self):
@@ -462,20 +490,20 @@ class StateSpace:
     def _step(self, dt, v_new):
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
-        v_new = np.array(v_new, dtype=float)
-        if v_new.shape != self._v.shape:
-            v_new = v_new.reshape(self._v.shape)
+        if type(v_new) is not np.ndarray or v_new.shape != self._v.shape:
+            v_new = np.asarray(v_new, dtype=float).reshape(self._v.shape)
         z, force = self._z, self.force
         if self._mu.size:
             e, b, whole = self._discrete(dt)
             if whole is not None:   # [z_new (real view); F] = whole·[z (real view); v_old; v_new]
-                out = whole @ np.concatenate((z.view(float), self._v, v_new))
-                return float(dt), v_new, out[:2 * z.size].view(complex), out[2 * z.size:]
+                u = np.concatenate((z.view(float), self._v, v_new))   # (a copy of v_new: kept)
+                out = whole @ u
+                return float(dt), u[u.size - v_new.size:], out[:2 * z.size].view(complex), out[2 * z.size:]
             u = self._u
             u[:v_new.size], u[v_new.size:] = self._v, v_new
             z = e * z + (b @ u).view(complex)
             force = self._gain @ z.view(float)
-        return float(dt), v_new, z, force
+        return float(dt), np.array(v_new, dtype=float), z, force
 
     def peek(self, dt, v_new):
         """The memory load F(t + dt) if the velocity reached v_new at t + dt, without
@@ -483,10 +511,12 @@ class StateSpace:
         self._peeked = self._step(dt, v_new)
         return self._peeked[3].copy()
 
-    def advance(self, dt, v_new):
-        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt)."""
+    def advance(self, dt, v_new, peeked=False):
+        """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt).
+        ``peeked``: the caller knows (dt, v_new) are the last ``peek``'s arguments, which
+        are then not compared (without a pending peek the step is computed all the same)."""
         p = self._peeked
-        if p is None or p[0] != dt or p[1].tolist() != np.asarray(v_new).tolist():   # (cheaper on lists)
+        if p is None or not peeked and (p[0] != dt or p[1].tolist() != np.asarray(v_new).tolist()):   # (lists: cheaper)
             p = self._step(dt, v_new)
         _, self._v, self._z, self.force = p
         self._peeked = None
