@@ -568,6 +568,7 @@ class DynamicsSlave(ArraySlave):
                                  + tuple(part["acceleration"] for part in self.parts)]
         self.finish_registration()
         self.solver = None
+        self.last_loads = None   # (summed loads, step) of the last step: the linear hold's slope
         self.stale = False
 
     def start_physics(self):
@@ -603,23 +604,23 @@ class DynamicsSlave(ArraySlave):
         x = self.values[self._load_vrs]
         if not _finite(x.tolist()) and not self.check_finite(self.load_inputs):
             return
-        loads = (self._load_sum @ x).reshape(-1, 6)
+        loads = self._load_sum.dot(x)   # [F; M] of every body, one after the other
         rates = None
         if self.config.load_hold == "linear":
             # first-order hold: extrapolate the load with its slope over the last step
-            last = getattr(self, "last_loads", None)
-            rates = np.zeros_like(loads) if last is None else (loads - last[0]) / last[1]
+            last = self.last_loads
+            rates = loads * 0.0 if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
         if self.solver is not None:
             acc = self.solver.step(dt, loads, rates)
         else:
-            acc = self.bodies[0].step(dt, loads[0], None if rates is None else rates[0])
+            acc = self.bodies[0].step(dt, loads, rates)
         self._publish(acc)
 
     def physics_state(self):
         if not hasattr(self, "bodies"):
             return None
-        last = getattr(self, "last_loads", None)
+        last = self.last_loads
         return {"bodies": [b.state() for b in self.bodies],
                 "last_loads": None if last is None else (last[0].copy(), last[1])}
 
@@ -628,7 +629,7 @@ class DynamicsSlave(ArraySlave):
             for body, s in zip(self.bodies, state["bodies"]):
                 body.set_state(s)
             last = state["last_loads"]
-            self.last_loads = None if last is None else (np.asarray(last[0], dtype=float), last[1])
+            self.last_loads = None if last is None else (np.asarray(last[0], dtype=float).ravel(), last[1])
 
 
 class ConnectorSlave(ArraySlave):

@@ -82,7 +82,12 @@ try:   # the gufunc behind np.linalg.solve, without their ~3 µs of wrapping per
     from numpy.linalg._umath_linalg import solve1 as _solve
 except ImportError:  # pragma: no cover - other numpy layouts
     _solve = np.linalg.solve
-_sum = np.add.reduce   # ndarray.sum without its Python-level wrapper
+
+
+def _finite(x):
+    """True if every entry of the small array x is finite (barring an overflow of their sum,
+    which callers then look at closer); a sum of floats is ~5× cheaper than a numpy reduction."""
+    return math.isfinite(sum(x.tolist()))
 
 GIMBAL_TOL = 1e-6  # |cos θ| below which the Euler-angle rates are declared singular
 
@@ -150,22 +155,28 @@ class _Equations:
         self.kd = kd[:, self.order]
         self.first = bodies[0]   # names the body in a singular-matrix error
         self._tables = {}
+        self._big = self.const.copy()   # the stages' mass matrix (rotating entries put anew in each)
 
     def parts(self, yl, signs=None):
         """Rotating mass-matrix entries (constant part included, at ``block_idx``), bias
         b and kinematic rates [ẋ; φ̇, θ̇, ψ̇] of every body, as floats, at the reordered state
-        ``yl`` (a list).  ``signs``: sign of cos θ of each body at the start of the step
-        (default: now); a cos θ below GIMBAL_TOL on that side raises GimbalLockError."""
+        ``yl`` (a list), and ``signs``: the sign of cos θ of each body at the start of the
+        step (default: now); a cos θ below GIMBAL_TOL on that side raises GimbalLockError."""
         n6 = 6 * self.n
         kin, bias, blocks = [], [], []
         c = self.block_const
+        now = signs is None
+        if now:
+            signs = []
         at = 0
         for i, (m, cog, io_b) in enumerate(self.props):
             phi, theta, psi = yl[6 * i + 3:6 * i + 6]
             vx, vy, vz, wx, wy, wz = yl[n6 + 6 * i:n6 + 6 * i + 6]
             cf, sf, ct, st, cp, sp = (math.cos(phi), math.sin(phi), math.cos(theta), math.sin(theta),
                                       math.cos(psi), math.sin(psi))
-            if ct * (signs[i] if signs else (1.0 if ct > 0.0 else -1.0)) < GIMBAL_TOL:
+            if now:
+                signs.append(1.0 if ct > 0.0 else -1.0)
+            if ct * signs[i] < GIMBAL_TOL:
                 raise GimbalLockError(_gimbal_message(np.array([phi, theta, psi])))
             # R = Rz(ψ)·Ry(θ)·Rx(φ); Euler rates solving ω = T·[φ̇, θ̇, ψ̇]
             r00, r01, r02 = cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf
@@ -207,7 +218,7 @@ class _Equations:
             at += 18
             ux, uy, uz = wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx          # ω × r
             bias += (m * (wy * uz - wz * uy), m * (wz * ux - wx * uz), m * (wx * uy - wy * ux)) + gyro
-        return blocks, bias, kin
+        return blocks, bias, kin, signs
 
     def matrix(self, blocks):
         big = self.const.copy()
@@ -224,92 +235,97 @@ class _Equations:
 
     def start(self, yp, signs=None):
         """What a step needs at the reordered state yp, whatever the load: (kinematic
-        rates, M_rb + A, right-hand side without the load).  The acceleration under a load
-        L is then (M_rb + A)⁻¹·(rhs + L): the published acceleration of one step and the
-        first stage of the next one share it."""
-        blocks, bias, kin = self.parts(yp.tolist(), signs)
-        rhs = self.k_eta0 - self.kd @ yp
+        rates, M_rb + A, right-hand side without the load, signs of cos θ).  The
+        acceleration under a load L is then (M_rb + A)⁻¹·(rhs + L): the published
+        acceleration of one step and the first stage of the next one share it."""
+        blocks, bias, kin, signs = self.parts(yp.tolist(), signs)
+        rhs = self.k_eta0 - self.kd.dot(yp)   # .dot: a third of @'s cost on small arrays
         rhs -= bias
-        return kin, self.matrix(blocks), rhs
+        return kin, self.matrix(blocks), rhs, signs
 
     def accelerations(self, y, load, start=None):
         """[a; α] of every body (6n,) at state y under ``load`` (``start``: ``self.start``
         of y, if known)."""
-        _, big, rhs = start or self.start(y[self.order])
+        big, rhs = (start or self.start(y[self.order]))[1:3]
         token = quiet.off()
         try:
             acc = _solve(big, rhs + load)
         finally:
             quiet.restore(token)
-        if not math.isfinite(_sum(acc)):
+        if not _finite(acc):
             self.check(big)
         return acc
 
     def table(self, h, method):
         """RK coefficients of ``method`` (RK4 or RK6) for an internal step h: rows
-        [1, h·a_s] per stage and [1, h·b]."""
+        [1, h·a_s] per stage, [1, h·b], and the stages' times h·c as a column."""
         t = self._tables.get((h, len(method[1])))
         if t is None:
-            ra, rb, _ = method
+            ra, rb, rc = method
             a = np.zeros((len(rb), len(rb) + 1))
             a[:, 0], a[:, 1:] = 1.0, h * ra
             b = np.concatenate([[1.0], h * rb])
-            t = self._tables[(h, len(rb))] = (a, b)
+            t = self._tables[(h, len(rb))] = (a, b, (h * rc)[:, None])
             if len(self._tables) > 8:
                 self._tables.pop(next(iter(self._tables)))
         return t
 
     def integrate(self, y, load, rate, dt, max_substep, start=None, checked=False):
-        """(state after dt [s] > 0 from y under load + rate·t (rate None: held load), and
-        ``start`` of that state).  ``start``: ``self.start`` of y, if known.  A result that
-        is not finite is computed again ``checked``: a singular matrix raises InputError."""
+        """(state after dt [s] > 0 from y under load + rate·t (rate None: held load),
+        ``start`` of that state, and the accelerations there under the load at the end of
+        the step).  ``start``: ``self.start`` of y, if known.  A result that is not finite
+        is computed again ``checked``: a singular matrix raises InputError."""
         if dt <= max_substep * (1.0 + 1e-12):   # 1e-12: round-off
             method, n = RK4, 1
         else:
             method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
         yp = y[self.order]
-        signs = [1.0 if math.cos(th) > 0.0 else -1.0 for th in yp[4:6 * self.n:6].tolist()]
+        if start is None:
+            start = self.start(yp)
         token = quiet.off()   # a non-finite result is checked below
         try:
-            yp = self._steps(yp, load, rate, dt / n, n, start, signs, method, checked)
+            yp = self._steps(yp, load, rate, dt / n, n, start, method, checked)
+            end = self.start(yp)   # (checks |cos θ| at the end of the step)
+            acc = _solve(end[1], end[2] + (load if rate is None else load + dt * rate))
         finally:
             quiet.restore(token)
-        if not math.isfinite(_sum(yp)):   # a singular matrix, or non-finite loads
+        if not (_finite(yp) and _finite(acc)):   # a singular matrix, or non-finite loads
             if not checked:
                 return self.integrate(y, load, rate, dt, max_substep, start, checked=True)
-            return yp[self.back], None
-        return yp[self.back], self.start(yp)   # (start checks |cos θ| at the end of the step)
+            return yp[self.back], None, acc
+        return yp[self.back], end, acc
 
-    def _steps(self, yp, load, rate, h, n, start, signs, method, checked):
-        """n internal steps h of ``method`` from the reordered state yp (integrate)."""
+    def _steps(self, yp, load, rate, h, n, start, method, checked):
+        """n internal steps h of ``method`` from the reordered state yp, whose ``start``
+        is given (integrate)."""
         n6 = 6 * self.n
-        a, b = self.table(h, method)
-        nodes, ns = method[2], len(method[1])
-        kd, parts, idx = self.kd, self.parts, self.block_idx
-        big = self.const.copy()   # the stages' mass matrix (its rotating entries put anew in each)
+        a, b, hc = self.table(h, method)
+        ns = len(a)
+        kd, parts, idx, big = self.kd, self.parts, self.block_idx, self._big
+        signs = start[3]
         stages = np.zeros((ns + 1, 2 * n6))    # [y; k_1 … k_s]; rows past a stage meet zeros of a
         base = load + self.k_eta0
         for m in range(n):
             if rate is None:
                 l0, forcing = load, [base] * ns
-            else:
+            else:   # the load at the step's start and at each stage's time
                 l0 = load + (m * h) * rate if m else load
-                forcing = base + ((m + nodes) * h)[:, None] * rate
-            kin, big0, rhs = start or self.start(yp, signs)
+                forcing = (base + (m * h) * rate if m else base) + hc * rate
+            kin, big0, rhs, _ = start or self.start(yp, signs)
             stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big0, rhs + l0)
-            if checked and not math.isfinite(_sum(stages[1])):
+            if checked and not _finite(stages[1]):
                 self.check(big0)
             for s in range(1, ns):
-                ys = a[s] @ stages
-                blocks, bias, kin = parts(ys.tolist(), signs)
-                rhs = forcing[s] - kd @ ys
+                ys = a[s].dot(stages)
+                blocks, bias, kin, _ = parts(ys.tolist(), signs)
+                rhs = forcing[s] - kd.dot(ys)
                 rhs -= bias
                 big.put(idx, blocks)
                 acc = stages[s + 1, n6:] = _solve(big, rhs)
                 stages[s + 1, :n6] = kin
-                if checked and not math.isfinite(_sum(acc)):
+                if checked and not _finite(acc):
                     self.check(big)
-            yp = b @ stages
+            yp = b.dot(stages)
             start = None
         return yp
 
@@ -405,10 +421,13 @@ class RigidBody:
         y = self._y
         if dt > 0.0:
             rate = None if load_rate is None else np.asarray(load_rate, dtype=float)
-            y, end = self._eq.integrate(y, load, rate, dt, self.max_substep, self._start())
+            y, end, acc = self._eq.integrate(y, load, rate, dt, self.max_substep, self._start())
             self._end = (y, end)
             if rate is not None:
                 load = load + rate * dt
+            if end is not None:
+                self._y, self._load = y, load
+                return acc
         self._y, self._load = y, load
         return self._eq.accelerations(y, load, self._start())
 
@@ -478,26 +497,33 @@ class CoupledBodies:
         the (n, 6) accelerations after the step (``accelerations``)."""
         loads = np.array(loads, dtype=float).ravel()
         last = self._last()
-        y = last[0] if last else np.concatenate([b._y for b in self.bodies])
-        end = last[2] if last else None
+        y, end = (last[0], last[2]) if last else (np.concatenate([b._y for b in self.bodies]), None)
+        acc = None
         if dt > 0.0:
             rates = None if rates is None else np.array(rates, dtype=float).ravel()
-            y, end = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
+            y, end, acc = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
             if rates is not None:
                 loads = loads + rates * dt
+        held = []
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
-        self._end = ([b._y for b in self.bodies] + [b._load for b in self.bodies], y, loads, end)
-        return self._eq.accelerations(y, loads, end).reshape(-1, 6)
+            held += (b._y, b._load)
+        self._end = (held, y, loads, end)
+        if acc is None or end is None:
+            acc = self._eq.accelerations(y, loads, end)
+        return acc.reshape(-1, 6)
 
     def _last(self):
         """(state, loads, _Equations.start of the state or None) of all bodies as the last
         step left them, while the bodies still hold them; else None."""
         end = self._end
-        if end is not None and all(a is b for a, b in zip(end[0], [b._y for b in self.bodies]
-                                                          + [b._load for b in self.bodies])):
-            return end[1:]
-        return None
+        if end is None:
+            return None
+        held = end[0]
+        for i, b in enumerate(self.bodies):
+            if b._y is not held[2 * i] or b._load is not held[2 * i + 1]:
+                return None
+        return end[1:]
 
     def accelerations(self):
         """(n, 6) accelerations from the current states and the last held loads."""
