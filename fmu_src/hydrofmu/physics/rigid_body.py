@@ -279,7 +279,7 @@ class _Equations:
             method, n = RK4, 1
         else:
             method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
-        yp = y[self.order]
+        yp = y[self.order] if self.n > 1 else y   # (one body: the order is [η; ν] already)
         if start is None:
             start = self.start(yp)
         token = quiet.off()   # a non-finite result is checked below
@@ -293,7 +293,7 @@ class _Equations:
             if not checked:
                 return self.integrate(y, load, rate, dt, max_substep, start, checked=True)
             return yp[self.back], None, acc
-        return yp[self.back], end, acc
+        return (yp[self.back] if self.n > 1 else yp), end, acc
 
     def _steps(self, yp, load, rate, h, n, start, method, checked):
         """n internal steps h of ``method`` from the reordered state yp, whose ``start``
