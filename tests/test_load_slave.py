@@ -50,3 +50,24 @@ def test_stacked_memories_follow_their_own_evaluators_when_inputs_change_before_
         np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-9 * np.abs(want).max())
         biggest = max(biggest, np.abs(want).max())
     assert biggest > 1e3   # N: the memory loads are not trivially zero
+
+
+def test_cached_value_references_follow_the_list_and_the_mode():
+    """set_real/get_real keep the index arrays of the lists a master passes every step: a list
+    changed in place gets its own values, and a parameter the cache accepted in initialization
+    mode is refused after it (one error line naming it)."""
+    slave = inprocess.system(load_scene(MODELS / "side_by_side.toml")).instances["barge_b"].slave
+    vr = {v.name: k for k, v in slave.vars.items()}
+    slave.setup_experiment(0.0)
+    slave.enter_initialization_mode()
+    vrs = [vr["rho"], vr["velocity[1]"]]
+    slave.set_real(vrs, [1000.0, 0.1])
+    assert slave.get_real(vrs) == [1000.0, 0.1]
+    slave.exit_initialization_mode()
+    slave.log_queue.clear()
+    slave.set_real(vrs, [1025.0, 0.2])
+    errors = [m.msg for m in slave.log_queue]
+    assert len(errors) == 1 and "cannot set rho: a parameter, fixed after initialization" in errors[0]
+    vrs[0] = vr["velocity[2]"]                  # the same list object, other contents
+    slave.set_real(vrs, [0.3, 0.4])
+    assert slave.get_real([vr["rho"]] + vrs) == [1000.0, 0.3, 0.4]

@@ -131,6 +131,9 @@ class ArraySlave(Fmi2Slave):
         self.next_time = None   # the communication point the next fmi2DoStep must start from
         self.checked = False    # outputs known finite (set by an evaluation that checked them all)
         self._finite_idx = {}   # check_finite: id of a list of input slices -> (it, its value indices)
+        self._vr_idx = {}       # tuple of value references -> (index array, settable in/after initialization)
+        self._vr_last = {}      # "get"/"set" -> (the last list of value references, its _vr_idx entry)
+        self.suspect = True     # inputs may be non-finite (set since the last check found them finite)
 
     # -- registration ------------------------------------------------------------------
     def add(self, name, causality, unit=None, start=0.0, description=None):
@@ -195,6 +198,7 @@ class ArraySlave(Fmi2Slave):
                          "turns every level of the profile")
         self.rho = self.add("rho", Fmi2Causality.parameter, "kg/m3", env.rho, "water density")
         self.g = self.add("g", Fmi2Causality.parameter, "m/s2", env.g, "acceleration of gravity")
+        self._env_vals = slice(self.current.start if self.current else self.rho, self.g + 1)   # registered together
         return [self.current] if self.current else []
 
     def add_matrix(self, name, causality, matrix, description):
@@ -218,15 +222,9 @@ class ArraySlave(Fmi2Slave):
 
     def env(self):
         """Env of the current values (the same object while they do not change)."""
-        idx = getattr(self, "_env_idx", None)
-        if idx is None:
-            idx = self._env_idx = [self.rho, self.g] + (list(range(self.current.start, self.current.stop))
-                                                        if self.current else [])
-        key = self.values[idx].tolist()
-        if not self.current:
-            key += [0.0, 0.0]
+        key = self.values[self._env_vals].tolist()   # [current speed, direction,] rho, g
         if key != getattr(self, "_env_key", None):
-            self._env_key, self._env = key, Env(*key, self.profile)
+            self._env_key, self._env = key, Env(key[-2], key[-1], *(key[:-2] or (0.0, 0.0)), self.profile)
         return self._env
 
     def finish_registration(self):
@@ -266,28 +264,52 @@ class ArraySlave(Fmi2Slave):
     def terminate(self):
         pass
 
+    def _refs(self, vrs, call):
+        """(index array, settable in initialization, settable after it) of a ``call``'s value
+        references: cached by their tuple, since a master passes the same ones every step
+        (numpy's conversion of a list costs ~1 µs), and the last list of each call kept to
+        compare with the next (cheaper than hashing a tuple)."""
+        last = self._vr_last.get(call)
+        if last is not None and type(vrs) is list and last[0] == vrs:
+            return last[1]
+        key = tuple(vrs)
+        known = self._vr_idx.get(key)
+        if known is None:
+            if len(self._vr_idx) > 64:
+                self._vr_idx.clear()
+            idx = np.array(key, dtype=np.intp)
+            if idx.size and not (0 <= idx.min() and idx.max() < self.values.size):
+                raise IndexError(f"value reference out of range 0…{self.values.size - 1}: {list(key)}")
+            known = self._vr_idx[key] = (idx, self.settable.issuperset(key), self.settable_running.issuperset(key))
+        self._vr_last[call] = (list(key), known)
+        return known
+
     @guarded(lambda self, vrs: [math.nan] * len(vrs))
     def get_real(self, vrs):
+        idx = self._refs(vrs, "get")[0]
         if self.stale:
             self.evaluate()
         if self.error is not None:   # kept: the next fmi2DoStep fails on it too
             self.fail(self.error)
-            return self.values[vrs].tolist()
-        out = self.values[vrs].tolist()
+            return self.values[idx].tolist()
+        out = self.values[idx].tolist()
         if not _finite(out):
-            self.check_outputs(vrs)
+            self.check_outputs(idx)
         return out
 
     @guarded()
     def set_real(self, vrs, values):
-        if not (self.settable_running if self.running else self.settable).issuperset(vrs):
+        idx, settable, settable_running = self._refs(vrs, "set")
+        if not (settable_running if self.running else settable):
             fixed = [vr for vr in vrs if vr not in self.settable or (self.running and vr in self._params)]
             var = self.vars[fixed[0]]
             why = ("a parameter, fixed after initialization" if var.causality == Fmi2Causality.parameter
                    else f"not settable ({var.causality.name})")
             self.fail(f"cannot set {var.name}: {why}")
             return
-        self.values[vrs] = values
+        self.values[idx] = values
+        if not self.suspect:
+            self.suspect = not _finite(values.tolist() if isinstance(values, np.ndarray) else values)
         self.stale = True
         self.error = None   # new inputs: the next evaluation checks them afresh
 
@@ -395,7 +417,7 @@ class ArraySlave(Fmi2Slave):
         self.values[:] = state["values"]
         self.set_physics_state(state["physics"])
         self.next_time, self.running = state["next_time"], state["running"]
-        self.stale, self.checked = True, False
+        self.stale, self.checked, self.suspect = True, False, True
         self.error = None
 
     @staticmethod
@@ -463,6 +485,9 @@ class LoadSlave(ArraySlave):
         if not explicit:
             for c in self.couplings:
                 self.add_mass_export(f"{c['cfg'].name}.mass_matrix", c["mass"])
+        ne = len(self.loads.effects)   # (row k of the output block: see evaluate)
+        self._explicit = [(k, c["mass"], c["acceleration"]) for k, c in enumerate(self.couplings, 1 + ne)
+                          if c["acceleration"] is not None]
         self.finish_registration()
         self.memories = []   # set up by start_physics
         self.stale = True
@@ -489,18 +514,19 @@ class LoadSlave(ArraySlave):
 
     def evaluate(self):
         self.stale = self.checked = False
-        if not self.check_finite(self.inputs):
-            return
+        if self.suspect:   # an input set since the last check may be non-finite
+            if not self.check_finite(self.inputs):
+                return
+            self.suspect = False
         v = self.values
         ne = len(self.loads.effects)
         out = np.zeros((1 + ne + len(self.couplings), 6))   # total, effects, couplings
         if ne:
-            out[1:1 + ne] = self.loads.effect_loads(self.motion(self.motion_inputs), self.env())
+            self.loads.effect_loads(self.motion(self.motion_inputs), self.env(), out[1:1 + ne])
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
-        for k, c in enumerate(self.couplings, 1 + ne):
-            if c["acceleration"] is not None:
-                out[k] -= c["mass"] @ v[c["acceleration"]]
+        for k, mass, acc in self._explicit:
+            out[k] -= mass @ v[acc]
         out[0] = self._load_total @ out
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the

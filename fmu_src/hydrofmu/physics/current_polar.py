@@ -189,12 +189,13 @@ class CurrentPolar:
         return cls(name or data.name, angles, cx, cy, cmz, data.xc, data.yc, data.zc, data.surfc)
 
     def coefficients(self, alpha):
-        """[CXC, CYC, CMZC] (floats) at incidence ``alpha`` [deg] in [0, 360), linear with
+        """(CXC, CYC, CMZC) (floats) at incidence ``alpha`` [deg] in [0, 360), linear with
         wrap-around."""
         angles, coef, slope = self._rows
         i = bisect.bisect_right(angles, alpha) - 1
         d = alpha - angles[i]
-        return [c + d * s for c, s in zip(coef[i], slope[i])]
+        (c0, c1, c2), (s0, s1, s2) = coef[i], slope[i]
+        return c0 + d * s0, c1 + d * s1, c2 + d * s2
 
     def load(self, motion, env):
         """[force N; moment N·m about the reference point], global axes."""
@@ -203,7 +204,7 @@ class CurrentPolar:
         px, py, pz = self.xc, self.yc, self.zc
         rx, ry, rz = r00 * px + r01 * py + r02 * pz, r10 * px + r11 * py + r12 * pz, r20 * px + r21 * py + r22 * pz
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
-        cx, cy, cz = env.current_at(float(motion.position[2]) + rz).tolist()   # current at P
+        cx, cy, cz = env.current_xyz(float(motion.position[2]) + rz)   # current at P
         ux, uy, uz = cx - (vx + wy * rz - wz * ry), cy - (vy + wz * rx - wx * rz), cz - (vz + wx * ry - wy * rx)
         bx, by = r00 * ux + r10 * uy + r20 * uz, r01 * ux + r11 * uy + r21 * uz   # body axes
         v2 = bx * bx + by * by
@@ -211,7 +212,8 @@ class CurrentPolar:
         if alpha >= 360.0:  # -tiny % 360 rounds to 360
             alpha = 0.0
         q = 0.5 * env.rho * self.surfc * v2
-        c0, c1, c2 = (q * c for c in self.coefficients(alpha))
+        c0, c1, c2 = self.coefficients(alpha)
+        c0, c1, c2 = q * c0, q * c1, q * c2
         fx, fy, fz = r00 * c0 + r01 * c1, r10 * c0 + r11 * c1, r20 * c0 + r21 * c1
         return np.array((fx, fy, fz, ry * fz - rz * fy + r02 * c2, rz * fx - rx * fz + r12 * c2,
                          rx * fy - ry * fx + r22 * c2))

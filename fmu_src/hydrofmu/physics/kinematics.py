@@ -86,8 +86,13 @@ def point_mass_matrix(mass3, r_global):
 def current_velocity(speed, direction_deg):
     """Global current velocity [m/s] for a speed and a 'going to' direction in degrees,
     counter-clockwise from global +x (horizontal, uniform)."""
+    return np.array(current_components(speed, direction_deg))
+
+
+def current_components(speed, direction_deg):
+    """``current_velocity`` as a tuple of three floats (for kernels on plain floats)."""
     d = math.radians(direction_deg)
-    return np.array([speed * math.cos(d), speed * math.sin(d), 0.0])
+    return (speed * math.cos(d), speed * math.sin(d), 0.0)
 
 
 def quad(x):

@@ -55,9 +55,10 @@ class BodyLoads:
         self.uses_current = any(e.uses_current for e in self.effects)
         self.uses_acceleration = any(e.uses_acceleration for e in self.effects)
 
-    def effect_loads(self, motion, env):
-        """(n_effects, 6) loads on the body, global axes, about the reference point."""
-        out = np.empty((len(self.effects), 6))
+    def effect_loads(self, motion, env, out=None):
+        """(n_effects, 6) loads on the body, global axes, about the reference point (into
+        ``out`` if given)."""
+        out = np.empty((len(self.effects), 6)) if out is None else out
         for i, eff in enumerate(self.effects):
             load = eff.load(motion, env)
             if eff.uses_acceleration:

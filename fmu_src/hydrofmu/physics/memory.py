@@ -403,20 +403,22 @@ class StateSpace:
                 out.append(i)
                 k += 2 if om else 1
         self.order = sum(f.order for f in self.fits.values())   # real states
-        self._set_modes(np.array(mu, complex), np.array(gam, complex), np.array(inp, int), np.array(out, int))
-        self._v = _start(self.shape, v0)
+        self._set_modes(np.array(mu, complex), np.array(gam, complex), np.array(inp, int), np.array(out, int),
+                        _start(self.shape, v0))
 
-    def _set_modes(self, mu, gam, inp, out):
-        """Set the modes (μ, γ, input and output index of each) and a zero state."""
+    def _set_modes(self, mu, gam, inp, out, v):
+        """Set the modes (μ, γ, input and output index of each), a zero modal state and the
+        velocity v.  The state is one real vector x = [z as (Re z₀, Im z₀, Re z₁, …); v]."""
         self._mu, self._gam, self._inp, self._out = mu, gam, inp, out
-        self._z = np.zeros(len(mu), complex)
-        # Products on real views of the complex modal state (z as [Re z₀, Im z₀, Re z₁, …]),
-        # so each step is two small real matrix products: F = −Re(Γ·z) = gain·z_real.
         m = len(mu)
+        self._nz = 2 * m
+        self._x = np.concatenate((np.zeros(2 * m), v))
+        # Products on real views of the complex modal state, so each step is two small real
+        # matrix products (or one, W below): F = −Re(Γ·z) = gain·z_real.
         self._gain = np.zeros((self.shape[0], 2 * m))
         self._gain[self._out, 2 * np.arange(m)] = -self._gam.real
         self._gain[self._out, 2 * np.arange(m) + 1] = self._gam.imag
-        self._u = np.zeros(2 * self.shape[1])       # [v_old, v_new]
+        self._u = np.zeros(2 * m + 2 * self.shape[1])   # [z; v_old; v_new], W's operand
         self._cache = OrderedDict()
         self._last_dt, self._last = None, None
         self._peeked = None
@@ -437,29 +439,30 @@ class StateSpace:
             at_in.append(at_in[-1] + p.shape[1])
         self.shape, self.fits = (at_out[-1], at_in[-1]), fits
         self.order = sum(p.order for p in parts)
-        join = lambda arrays, dtype: np.concatenate([np.zeros(0, dtype)] + list(arrays))   # noqa: E731
+        join = lambda arrays, dtype=float: np.concatenate([np.zeros(0, dtype)] + list(arrays))   # noqa: E731
         self._set_modes(join((p._mu for p in parts), complex), join((p._gam for p in parts), complex),
-                    join((p._inp + a for p, a in zip(parts, at_in)), int),
-                    join((p._out + a for p, a in zip(parts, at_out)), int))
-        self._z = join((p._z for p in parts), complex)
-        self._v = join((p._v for p in parts), float)
-        self.force = join((p.force for p in parts), float)
+                        join((p._inp + a for p, a in zip(parts, at_in)), int),
+                        join((p._out + a for p, a in zip(parts, at_out)), int),
+                        join(p._x[p._nz:] for p in parts))
+        self._x[:self._nz] = join(p._x[:p._nz] for p in parts)
+        self.force = join(p.force for p in parts)
         return self
 
     @property
     def velocity(self):
-        return self._v.copy()
+        return self._x[self._nz:].copy()
 
     def restart(self, v0):
         """Set the velocity at the start (before any ``advance``; the states are still zero)."""
-        self._v = _start(self.shape, v0)
+        self._x = np.concatenate((self._x[:self._nz], _start(self.shape, v0)))
         self._peeked = None
 
     def _discrete(self, dt):
         """(e^{μdt}, B, W) for a step dt: z_new = e·z + B·[v_old; v_new], with B (real view,
         2·modes × 2·n_in) holding dt·(φ₁ − φ₂) on v_old and dt·φ₂ on v_new of each mode's input;
-        W (up to DENSE_STATES real states, else None) gives [z_new; F] = W·[z; v_old; v_new] on
-        the real view in one product (cheaper than four small numpy calls)."""
+        W (up to DENSE_STATES real states, else None) gives the new state and load
+        [z_new; v_new; F] = W·[z; v_old; v_new] on the real view in one product (cheaper than
+        four small numpy calls; v_new passes through an identity block)."""
         if dt == self._last_dt:                   # the usual case: a constant step
             return self._last
         key = float(dt)
@@ -479,7 +482,8 @@ class StateSpace:
                 i = 2 * np.arange(m)
                 rot[i, i], rot[i, i + 1], rot[i + 1, i], rot[i + 1, i + 1] = e.real, -e.imag, e.imag, e.real
                 top = np.hstack([rot, real])
-                whole = np.vstack([top, self._gain @ top])
+                through = np.hstack([np.zeros((n_in, 2 * m + n_in)), np.eye(n_in)])
+                whole = np.vstack([top, through, self._gain @ top])
             self._cache[key] = (e, real, whole)
             if len(self._cache) > 16:
                 self._cache.popitem(last=False)
@@ -488,48 +492,52 @@ class StateSpace:
         return self._last
 
     def _step(self, dt, v_new):
+        """(dt, the state x after the step, the load F after it), nothing moved."""
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt}")
-        if type(v_new) is not np.ndarray or v_new.shape != self._v.shape:
-            v_new = np.asarray(v_new, dtype=float).reshape(self._v.shape)
-        z, force = self._z, self.force
-        if self._mu.size:
-            e, b, whole = self._discrete(dt)
-            if whole is not None:   # [z_new (real view); F] = whole·[z (real view); v_old; v_new]
-                u = np.concatenate((z.view(float), self._v, v_new))   # (a copy of v_new: kept)
-                out = whole @ u
-                return float(dt), u[u.size - v_new.size:], out[:2 * z.size].view(complex), out[2 * z.size:]
-            u = self._u
-            u[:v_new.size], u[v_new.size:] = self._v, v_new
-            z = e * z + (b @ u).view(complex)
-            force = self._gain @ z.view(float)
-        return float(dt), np.array(v_new, dtype=float), z, force
+        nz, n = self._nz, self.shape[1]
+        if type(v_new) is not np.ndarray or v_new.shape != (n,):
+            v_new = np.asarray(v_new, dtype=float).reshape(n)
+        if not nz:
+            return float(dt), np.array(v_new, dtype=float), self.force
+        e, b, whole = self._discrete(dt)
+        u = self._u
+        u[:nz + n] = self._x
+        u[nz + n:] = v_new
+        if whole is not None:           # [z_new; v_new; F] = W·[z; v_old; v_new]: one product
+            out = whole @ u
+            return float(dt), out[:nz + n], out[nz + n:]
+        z = e * self._x[:nz].view(complex) + (b @ u[nz:]).view(complex)
+        return float(dt), np.concatenate((z.view(float), v_new)), self._gain @ z.view(float)
 
     def peek(self, dt, v_new):
         """The memory load F(t + dt) if the velocity reached v_new at t + dt, without
         moving (a following ``advance`` with the same arguments reuses the result)."""
         self._peeked = self._step(dt, v_new)
-        return self._peeked[3].copy()
+        return self._peeked[2].copy()
 
     def advance(self, dt, v_new, peeked=False):
         """Move to t + dt [s] with velocity v_new; return the memory load F(t + dt).
         ``peeked``: the caller knows (dt, v_new) are the last ``peek``'s arguments, which
         are then not compared (without a pending peek the step is computed all the same)."""
         p = self._peeked
-        if p is None or not peeked and (p[0] != dt or p[1].tolist() != np.asarray(v_new).tolist()):   # (lists: cheaper)
-            p = self._step(dt, v_new)
-        _, self._v, self._z, self.force = p
+        if p is None or not peeked and (p[0] != dt or p[1][self._nz:].tolist() != np.asarray(v_new).tolist()):
+            p = self._step(dt, v_new)    # (compared as lists: cheaper than numpy on a few values)
+        _, self._x, self.force = p
         self._peeked = None
         return self.force.copy()
 
     def state(self):
         """Modal states (real and imaginary parts), current velocity and load, as plain lists."""
-        return {"z_re": self._z.real.tolist(), "z_im": self._z.imag.tolist(),
-                "v": self._v.tolist(), "force": self.force.tolist()}
+        x, nz = self._x, self._nz
+        return {"z_re": x[0:nz:2].tolist(), "z_im": x[1:nz:2].tolist(),
+                "v": x[nz:].tolist(), "force": self.force.tolist()}
 
     def set_state(self, state):
         """Restore a ``state()``."""
-        self._z = np.array(state["z_re"], float) + 1j * np.array(state["z_im"], float)
-        self._v = np.array(state["v"], float).reshape(self.shape[1])
+        x, nz = np.empty(self._x.size), self._nz
+        x[0:nz:2], x[1:nz:2] = state["z_re"], state["z_im"]
+        x[nz:] = np.array(state["v"], float).reshape(self.shape[1])
+        self._x = x
         self.force = np.array(state["force"], float)
         self._peeked = None
