@@ -12,10 +12,13 @@ try:
     _IGNORE = _make_extobj(all="ignore")
 
     def off():
+        if _extobj_contextvar.get() is _IGNORE:   # already off (nested): nothing to undo
+            return None
         return _extobj_contextvar.set(_IGNORE)
 
     def restore(token):
-        _extobj_contextvar.reset(token)
+        if token is not None:
+            _extobj_contextvar.reset(token)
 except ImportError:  # pragma: no cover - other numpy versions
     def off():
         state = np.errstate(all="ignore")

@@ -272,9 +272,9 @@ class _Equations:
 
     def integrate(self, y, load, rate, dt, max_substep, start=None, checked=False):
         """(state after dt [s] > 0 from y under load + rate·t (rate None: held load),
-        ``start`` of that state, and the accelerations there under the load at the end of
-        the step).  ``start``: ``self.start`` of y, if known.  A result that is not finite
-        is computed again ``checked``: a singular matrix raises InputError."""
+        ``start`` of that state, the load at the end of the step and the accelerations
+        there under it).  ``start``: ``self.start`` of y, if known.  A result that is not
+        finite is computed again ``checked``: a singular matrix raises InputError."""
         if dt <= max_substep * (1.0 + 1e-12):   # 1e-12: round-off
             method, n = RK4, 1
         else:
@@ -286,14 +286,15 @@ class _Equations:
         try:
             yp = self._steps(yp, load, rate, dt / n, n, start, method, checked)
             end = self.start(yp)   # (checks |cos θ| at the end of the step)
-            acc = _solve(end[1], end[2] + (load if rate is None else load + dt * rate))
+            load_end = load if rate is None else load + dt * rate
+            acc = _solve(end[1], end[2] + load_end)
         finally:
             quiet.restore(token)
         if not (_finite(yp) and _finite(acc)):   # a singular matrix, or non-finite loads
             if not checked:
                 return self.integrate(y, load, rate, dt, max_substep, start, checked=True)
-            return yp[self.back], None, acc
-        return (yp[self.back] if self.n > 1 else yp), end, acc
+            return yp[self.back], None, load_end, acc
+        return (yp[self.back] if self.n > 1 else yp), end, load_end, acc
 
     def _steps(self, yp, load, rate, h, n, start, method, checked):
         """n internal steps h of ``method`` from the reordered state yp, whose ``start``
@@ -421,10 +422,8 @@ class RigidBody:
         y = self._y
         if dt > 0.0:
             rate = None if load_rate is None else np.asarray(load_rate, dtype=float)
-            y, end, acc = self._eq.integrate(y, load, rate, dt, self.max_substep, self._start())
+            y, end, load, acc = self._eq.integrate(y, load, rate, dt, self.max_substep, self._start())
             self._end = (y, end)
-            if rate is not None:
-                load = load + rate * dt
             if end is not None:
                 self._y, self._load = y, load
                 return acc
@@ -501,9 +500,7 @@ class CoupledBodies:
         acc = None
         if dt > 0.0:
             rates = None if rates is None else np.array(rates, dtype=float).ravel()
-            y, end, acc = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
-            if rates is not None:
-                loads = loads + rates * dt
+            y, end, loads, acc = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
         held = []
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
