@@ -147,8 +147,15 @@ class _Equations:
         for (i, j), m in (cross or {}).items():
             self.const[6 * i:6 * i + 6, 6 * j:6 * j + 6] += m
         self.block_idx = np.concatenate(block_idx)
-        # the constant part under the rotating blocks, added to them on floats
-        self.block_const = self.const.reshape(-1)[self.block_idx].tolist()
+        # the constant part under each body's rotating blocks (I_O's 9, then m·[r]×'s 18),
+        # added to them on floats
+        under = self.const.reshape(-1)[self.block_idx].tolist()
+        at = 0
+        for i, (m, cog, io_b) in enumerate(self.props):
+            k = 9 + (18 if cog else 0)
+            self.props[i] = (m, cog, io_b, io_b[1] == io_b[2] == io_b[4] == 0.0, tuple(under[at:at + 9]),
+                             under[at + 9:at + k])
+            at += k
         idx = np.arange(12 * n).reshape(n, 2, 6)
         self.order = np.concatenate([idx[:, 0].ravel(), idx[:, 1].ravel()])   # y[order]: [η…; ν…]
         self.back = np.argsort(self.order)
@@ -164,60 +171,57 @@ class _Equations:
         step (default: now); a cos θ below GIMBAL_TOL on that side raises GimbalLockError."""
         n6 = 6 * self.n
         kin, bias, blocks = [], [], []
-        c = self.block_const
         now = signs is None
         if now:
             signs = []
-        at = 0
-        for i, (m, cog, io_b) in enumerate(self.props):
-            phi, theta, psi = yl[6 * i + 3:6 * i + 6]
-            vx, vy, vz, wx, wy, wz = yl[n6 + 6 * i:n6 + 6 * i + 6]
-            cf, sf, ct, st, cp, sp = (math.cos(phi), math.sin(phi), math.cos(theta), math.sin(theta),
-                                      math.cos(psi), math.sin(psi))
+        cos, sin = math.cos, math.sin
+        for i, (m, cog, io_b, principal, c_io, c_r) in enumerate(self.props):
+            j = 6 * i
+            phi, theta, psi = yl[j + 3:j + 6]
+            vx, vy, vz, wx, wy, wz = yl[n6 + j:n6 + j + 6]
+            cf, sf, ct, st, cp, sp = cos(phi), sin(phi), cos(theta), sin(theta), cos(psi), sin(psi)
             if now:
                 signs.append(1.0 if ct > 0.0 else -1.0)
             if ct * signs[i] < GIMBAL_TOL:
                 raise GimbalLockError(_gimbal_message(np.array([phi, theta, psi])))
             # R = Rz(ψ)·Ry(θ)·Rx(φ); Euler rates solving ω = T·[φ̇, θ̇, ψ̇]
-            r00, r01, r02 = cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf
-            r10, r11, r12 = sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf
+            stsf, stcf = st * sf, st * cf
+            r00, r01, r02 = cp * ct, cp * stsf - sp * cf, cp * stcf + sp * sf
+            r10, r11, r12 = sp * ct, sp * stsf + cp * cf, sp * stcf - cp * sf
             r20, r21, r22 = -st, ct * sf, ct * cf
             phi_dot = (cp * wx + sp * wy) / ct
-            kin += (vx, vy, vz, phi_dot, -sp * wx + cp * wy, wz + st * phi_dot)
+            kin += (vx, vy, vz, phi_dot, cp * wy - sp * wx, wz + st * phi_dot)
             # inertia about O in global axes, R·I_O·Rᵀ (symmetric), and ω × (I_O·ω)
             a00, a01, a02, a11, a12, a22 = io_b
-            if a01 == a02 == a12 == 0.0:   # principal axes (most bodies): R·I_O on the diagonal only
+            if principal:   # principal axes (most bodies): R·I_O on the diagonal only
                 p00, p01, p02 = r00 * a00, r01 * a11, r02 * a22
                 p10, p11, p12 = r10 * a00, r11 * a11, r12 * a22
-                p20, p21, p22 = r20 * a00, r21 * a11, r22 * a22
+                i22 = r20 * r20 * a00 + r21 * r21 * a11 + r22 * r22 * a22
             else:
                 p00, p01, p02 = (r00 * a00 + r01 * a01 + r02 * a02, r00 * a01 + r01 * a11 + r02 * a12,
                                  r00 * a02 + r01 * a12 + r02 * a22)
                 p10, p11, p12 = (r10 * a00 + r11 * a01 + r12 * a02, r10 * a01 + r11 * a11 + r12 * a12,
                                  r10 * a02 + r11 * a12 + r12 * a22)
-                p20, p21, p22 = (r20 * a00 + r21 * a01 + r22 * a02, r20 * a01 + r21 * a11 + r22 * a12,
-                                 r20 * a02 + r21 * a12 + r22 * a22)
+                i22 = ((r20 * a00 + r21 * a01 + r22 * a02) * r20 + (r20 * a01 + r21 * a11 + r22 * a12) * r21
+                       + (r20 * a02 + r21 * a12 + r22 * a22) * r22)
             i00, i01, i02 = p00 * r00 + p01 * r01 + p02 * r02, p00 * r10 + p01 * r11 + p02 * r12, p00 * r20 + p01 * r21 + p02 * r22
             i11, i12 = p10 * r10 + p11 * r11 + p12 * r12, p10 * r20 + p11 * r21 + p12 * r22
-            i22 = p20 * r20 + p21 * r21 + p22 * r22
-            blocks += (c[at] + i00, c[at + 1] + i01, c[at + 2] + i02, c[at + 3] + i01, c[at + 4] + i11,
-                       c[at + 5] + i12, c[at + 6] + i02, c[at + 7] + i12, c[at + 8] + i22)
-            at += 9
+            c0, c1, c2, c3, c4, c5, c6, c7, c8 = c_io
+            blocks += (c0 + i00, c1 + i01, c2 + i02, c3 + i01, c4 + i11, c5 + i12, c6 + i02, c7 + i12, c8 + i22)
             hx, hy, hz = i00 * wx + i01 * wy + i02 * wz, i01 * wx + i11 * wy + i12 * wz, i02 * wx + i12 * wy + i22 * wz
-            gyro = (wy * hz - wz * hy, wz * hx - wx * hz, wx * hy - wy * hx)
+            gx, gy, gz = wy * hz - wz * hy, wz * hx - wx * hz, wx * hy - wy * hx   # ω × (I_O·ω)
             if cog is None:
-                bias += (0.0, 0.0, 0.0) + gyro
+                bias += (0.0, 0.0, 0.0, gx, gy, gz)
                 continue
             cx, cy, cz = cog
             rx, ry, rz = (r00 * cx + r01 * cy + r02 * cz, r10 * cx + r11 * cy + r12 * cz,
                           r20 * cx + r21 * cy + r22 * cz)
             mx, my, mz = m * rx, m * ry, m * rz
             # m·[r]× below, −m·[r]× above
-            blocks += [k + v for k, v in zip(c[at:at + 18], (0.0, -mz, my, mz, 0.0, -mx, -my, mx, 0.0,
-                                                               0.0, mz, -my, -mz, 0.0, mx, my, -mx, 0.0))]
-            at += 18
+            blocks += [k + v for k, v in zip(c_r, (0.0, -mz, my, mz, 0.0, -mx, -my, mx, 0.0,
+                                                  0.0, mz, -my, -mz, 0.0, mx, my, -mx, 0.0))]
             ux, uy, uz = wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx          # ω × r
-            bias += (m * (wy * uz - wz * uy), m * (wz * ux - wx * uz), m * (wx * uy - wy * ux)) + gyro
+            bias += (m * (wy * uz - wz * uy), m * (wz * ux - wx * uz), m * (wx * uy - wy * ux), gx, gy, gz)
         return blocks, bias, kin, signs
 
     def matrix(self, blocks):
