@@ -590,6 +590,8 @@ class DynamicsSlave(ArraySlave):
             for s in part["loads"]:
                 self._load_sum[6 * i:6 * i + 6, at:at + 6] = np.eye(6)
                 at += 6
+        if self._load_sum.shape[0] == self._load_sum.shape[1]:   # one load input per body: no sum
+            self._load_sum = None
         self._motion_vrs = np.r_[tuple(part[k] for part in self.parts for k in ("position", "attitude", "velocity"))
                                  + tuple(part["acceleration"] for part in self.parts)]
         self.finish_registration()
@@ -618,30 +620,33 @@ class DynamicsSlave(ArraySlave):
         self.error = None
 
     def _loads(self):
-        return (self._load_sum @ self.values[self._load_vrs]).reshape(-1, 6)
+        x = self.values[self._load_vrs]
+        return (x if self._load_sum is None else self._load_sum.dot(x)).reshape(-1, 6)
 
     def _publish(self, acc=None):
         """Motion outputs from the bodies' states and accelerations ``acc`` (default: computed)."""
         if acc is None:
             acc = self.solver.accelerations() if self.solver else self.bodies[0].acceleration
-        self.values[self._motion_vrs] = np.concatenate([b._y for b in self.bodies] + [acc.ravel()])
+        y = self.solver.y if self.solver is not None and self.solver.y is not None else None
+        self.values[self._motion_vrs] = np.concatenate(
+            (y, acc.ravel()) if y is not None else [b._y for b in self.bodies] + [acc.ravel()])
 
     def step_physics(self, t, dt):
         x = self.values[self._load_vrs]
         if not _finite(x.tolist()) and not self.check_finite(self.load_inputs):
             return
-        loads = self._load_sum.dot(x)   # [F; M] of every body, one after the other
+        loads = x if self._load_sum is None else self._load_sum.dot(x)   # [F; M] of every body in turn
         rates = None
         if self.config.load_hold == "linear":
             # first-order hold: extrapolate the load with its slope over the last step
             last = self.last_loads
             rates = loads * 0.0 if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
-        if self.solver is not None:
+        if self.solver is not None:   # the group's state is one vector already
             acc = self.solver.step(dt, loads, rates)
+            self.values[self._motion_vrs] = np.concatenate((self.solver.y, acc.ravel()))
         else:
-            acc = self.bodies[0].step(dt, loads, rates)
-        self._publish(acc)
+            self._publish(self.bodies[0].step(dt, loads, rates))
 
     def physics_state(self):
         if not hasattr(self, "bodies"):

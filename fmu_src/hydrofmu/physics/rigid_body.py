@@ -493,6 +493,7 @@ class CoupledBodies:
         self.max_substep = min(b.max_substep for b in self.bodies)
         self._eq = _Equations(self.bodies, self.cross)
         self._end = None   # (the bodies' states, _Equations.start of them) after a step
+        self.y = None      # the state after the last step
 
     def step(self, dt, loads, rates=None):
         """Advance all bodies by dt [s] with their external loads (list of (6,)) held, or
@@ -503,8 +504,9 @@ class CoupledBodies:
         y, end = (last[0], last[2]) if last else (np.concatenate([b._y for b in self.bodies]), None)
         acc = None
         if dt > 0.0:
-            rates = None if rates is None else np.array(rates, dtype=float).ravel()
+            rates = None if rates is None else np.asarray(rates, dtype=float).reshape(-1)
             y, end, loads, acc = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
+        self.y = y   # every body's [η; ν], one after the other (the bodies hold views of it)
         held = []
         for i, b in enumerate(self.bodies):
             b._y, b._load = y[12 * i:12 * i + 12], loads[6 * i:6 * i + 6]
