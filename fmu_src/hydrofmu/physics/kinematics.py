@@ -33,7 +33,25 @@ def cross(a, b):
     3-vectors, the hot paths call it every evaluation)."""
     a0, a1, a2 = a.tolist() if isinstance(a, np.ndarray) else a
     b0, b1, b2 = b.tolist() if isinstance(b, np.ndarray) else b
-    return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
+    return np.array(cross_floats(a0, a1, a2, b0, b1, b2))
+
+
+def rotate(rows, x, y, z):
+    """R·(x, y, z) with R given by its rows of floats (``Motion.rot_rows``): three floats.
+    The per-step kernels rotate 3-vectors on plain floats (numpy's per-call cost dominates)."""
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rows
+    return r00 * x + r01 * y + r02 * z, r10 * x + r11 * y + r12 * z, r20 * x + r21 * y + r22 * z
+
+
+def rotate_back(rows, x, y, z):
+    """Rᵀ·(x, y, z) (global to body axes) with R given by its rows of floats: three floats."""
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rows
+    return r00 * x + r10 * y + r20 * z, r01 * x + r11 * y + r21 * z, r02 * x + r12 * y + r22 * z
+
+
+def cross_floats(a0, a1, a2, b0, b1, b2):
+    """a × b of two 3-vectors given as floats: three floats."""
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
 def skew(r):
@@ -61,16 +79,6 @@ def transfer(force, r_global, moment=None):
     return np.concatenate([force, m])
 
 
-def to_global(load_body, rot):
-    """Rotate a 6-vector load given in body axes to global axes."""
-    return np.concatenate([rot @ load_body[:3], rot @ load_body[3:]])
-
-
-def to_body(vec6, rot):
-    """Express a global 6-vector (velocity or load) in body axes."""
-    return np.concatenate([rot.T @ vec6[:3], rot.T @ vec6[3:]])
-
-
 def point_mass_matrix(mass3, r_global):
     """6×6 mass matrix about the reference point of a point mass at global offset r.
 
@@ -93,8 +101,3 @@ def current_components(speed, direction_deg):
     """``current_velocity`` as a tuple of three floats (for kernels on plain floats)."""
     d = math.radians(direction_deg)
     return (speed * math.cos(d), speed * math.sin(d), 0.0)
-
-
-def quad(x):
-    """x·|x|: the quadratic term that keeps the sign of x."""
-    return x * np.abs(x)

@@ -34,9 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kinematics import cross, point_mass_matrix, point_velocity, quad, transfer
+from .kinematics import cross_floats, point_mass_matrix, rotate, rotate_back
 
-E_Z = np.array([0.0, 0.0, 1.0])
 
 
 def _vec3(x):
@@ -85,15 +84,27 @@ class LumpedBody:
         """Rotation from the coefficient axes to global axes."""
         return rot if self.icoo == "LOCAL" else np.eye(3)
 
+    # load and velocity_load work on plain floats: numpy's per-call cost dominates on 3-vectors
+
+    def _per_axis(self, motion, coef, power, x, y, z):
+        """Q·(c_i·u_i·|u_i| if power else c_i·u_i) with u = Qᵀ·(x, y, z), global, for the coefficient axes Q
+        (R if LOCAL, else I) and coefficients c = ``coef``: three floats."""
+        local = self.icoo == "LOCAL"
+        if local:
+            x, y, z = rotate_back(motion.rot_rows, x, y, z)
+        x, y, z = (c * u * abs(u) if power else c * u for c, u in zip(coef, (x, y, z)))
+        return rotate(motion.rot_rows, x, y, z) if local else (x, y, z)
+
     def load(self, motion, env):
         """Weight, buoyancy and drag on the body [N, N·m], global, about the reference point."""
-        rot = motion.rot
-        r = rot @ self.offset
-        vrel = env.current_at(motion.position[2] + r[2]) - point_velocity(motion.velocity, r)   # at the point
-        q = self._axes(rot)
-        force = q @ (self.cd * quad(q.T @ vrel))
-        force = force + (env.rho * env.g * self.ae - self.am * env.g) * E_Z
-        return transfer(force, r)
+        rx, ry, rz = rotate(motion.rot_rows, *self.offset.tolist())
+        vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
+        px, py, pz = cross_floats(wx, wy, wz, rx, ry, rz)
+        cx, cy, cz = env.current_xyz(float(motion.position[2]) + rz)   # the current at the point
+        ux, uy, uz = cx - (vx + px), cy - (vy + py), cz - (vz + pz)    # water past the point
+        fx, fy, fz = self._per_axis(motion, self.cd.tolist(), 1, ux, uy, uz)
+        fz += env.rho * env.g * self.ae - self.am * env.g
+        return np.array((fx, fy, fz) + cross_floats(rx, ry, rz, fx, fy, fz))
 
     def point_mass(self, motion):
         """3×3 translational mass M_p of the point [kg], global axes."""
@@ -105,7 +116,12 @@ class LumpedBody:
         return point_mass_matrix(self.point_mass(motion), motion.rot @ self.offset)
 
     def velocity_load(self, motion):
-        """Centripetal part of the inertia load [N, N·m]: transfer(−M_p·ω×(ω×R r), R r)."""
-        r = motion.rot @ self.offset
-        w = motion.velocity[3:]
-        return transfer(-self.point_mass(motion) @ cross(w, cross(w, r)), r)
+        """Centripetal part of the inertia load [N, N·m]: transfer(−M_p·ω×(ω×R r), R r), with
+        M_p·c = AM·c + Q·diag(AMX, AMY, AMZ)·Qᵀ·c."""
+        rx, ry, rz = rotate(motion.rot_rows, *self.offset.tolist())
+        wx, wy, wz = motion.velocity[3:].tolist()
+        cx, cy, cz = cross_floats(wx, wy, wz, *cross_floats(wx, wy, wz, rx, ry, rz))
+        ax, ay, az = self._per_axis(motion, self.added_mass.tolist(), 0, cx, cy, cz)
+        am = self.am
+        fx, fy, fz = -(am * cx + ax), -(am * cy + ay), -(am * cz + az)
+        return np.array((fx, fy, fz) + cross_floats(rx, ry, rz, fx, fy, fz))

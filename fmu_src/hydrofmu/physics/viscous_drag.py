@@ -15,7 +15,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .kinematics import quad, to_body, to_global
+from .kinematics import rotate, rotate_back
 
 
 @dataclass
@@ -41,11 +41,15 @@ class ViscousDrag:
 
     def load(self, motion, env):
         """[force N; moment N·m about the reference point], global axes."""
-        rot = motion.rot
-        w = to_body(motion.velocity, rot)
-        if self.relative:
-            w[:3] -= rot.T @ env.current_at(motion.position[2])   # current at the reference point
-        return to_global(-(self.matrix @ quad(w)), rot)
+        # plain floats for the rotations: numpy's per-call cost dominates on 3-vectors
+        rows = motion.rot_rows
+        vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
+        if self.relative:   # the current at the reference point
+            cx, cy, cz = env.current_xyz(float(motion.position[2]))
+            vx, vy, vz = vx - cx, vy - cy, vz - cz
+        w = rotate_back(rows, vx, vy, vz) + rotate_back(rows, wx, wy, wz)
+        fx, fy, fz, mx, my, mz = (self.matrix @ [x * abs(x) for x in w]).tolist()   # −F_body
+        return np.array(rotate(rows, -fx, -fy, -fz) + rotate(rows, -mx, -my, -mz))
 
     def mass_matrix(self, motion):
         return np.zeros((6, 6))
