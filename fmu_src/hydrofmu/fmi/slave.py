@@ -526,8 +526,8 @@ class LoadSlave(ArraySlave):
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
-            out[k] -= mass @ v[acc]
-        out[0] = self._load_total @ out
+            out[k] -= mass.dot(v[acc])
+        out[0] = self._load_total.dot(out)   # (ndarray.dot: half the call cost of @ here)
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the
         # sum only sends do_step to check them one by one)

@@ -48,7 +48,7 @@ class ViscousDrag:
             cx, cy, cz = env.current_xyz(float(motion.position[2]))
             vx, vy, vz = vx - cx, vy - cy, vz - cz
         w = rotate_back(rows, vx, vy, vz) + rotate_back(rows, wx, wy, wz)
-        fx, fy, fz, mx, my, mz = (self.matrix @ [x * abs(x) for x in w]).tolist()   # −F_body
+        fx, fy, fz, mx, my, mz = self.matrix.dot([x * abs(x) for x in w]).tolist()   # −F_body
         return np.array(rotate(rows, -fx, -fy, -fz) + rotate(rows, -mx, -my, -mz))
 
     def mass_matrix(self, motion):
