@@ -92,7 +92,9 @@ class LumpedBody:
         local = self.icoo == "LOCAL"
         if local:
             x, y, z = rotate_back(motion.rot_rows, x, y, z)
-        x, y, z = (c * u * abs(u) if power else c * u for c, u in zip(coef, (x, y, z)))
+        # c·(u·|u|), as numpy did: an overflowed u·|u| stays non-finite even where c = 0, so a
+        # diverging run still ends in fmi2Error
+        x, y, z = (c * (u * abs(u)) if power else c * u for c, u in zip(coef, (x, y, z)))
         return rotate(motion.rot_rows, x, y, z) if local else (x, y, z)
 
     def load(self, motion, env):
