@@ -71,3 +71,31 @@ def test_cached_value_references_follow_the_list_and_the_mode():
     vrs[0] = vr["velocity[2]"]                  # the same list object, other contents
     slave.set_real(vrs, [0.3, 0.4])
     assert slave.get_real([vr["rho"]] + vrs) == [1000.0, 0.3, 0.4]
+
+
+def test_a_running_state_restores_into_an_instance_not_yet_initialized():
+    """fmi2SetFMUstate of a running load FMU's serialized state into a fresh instance (its
+    memories not built yet): both continue with the same outputs."""
+    def fresh():
+        return inprocess.system(load_scene(MODELS / "side_by_side.toml")).instances["barge_b"].slave
+    run, other = fresh(), fresh()
+    vr = {v.name: k for k, v in run.vars.items()}
+    vel = [vr[f"velocity[{i}]"] for i in range(1, 7)] + [vr[f"barge_a.velocity[{i}]"] for i in range(1, 7)]
+    run.setup_experiment(0.0)
+    run.enter_initialization_mode()
+    run.exit_initialization_mode()
+    rng = np.random.default_rng(2)
+    for k in range(5):
+        run.set_real(vel, rng.normal(size=12).tolist())
+        assert run.do_step(0.05 * k, 0.05)
+    data = run._fmu_state_to_bytes(run._get_fmu_state())
+    other._set_fmu_state(other._fmu_state_from_bytes(data))
+    assert not other.log_queue
+    outs = run.output_vrs.tolist()
+    for k in range(5, 10):
+        v = rng.normal(size=12).tolist()
+        for s in (run, other):
+            s.set_real(vel, v)
+            assert s.do_step(0.05 * k, 0.05)
+        got, want = other.get_real(outs), run.get_real(outs)
+        assert got == want and any(x != 0.0 for x in want)

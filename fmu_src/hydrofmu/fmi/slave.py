@@ -543,7 +543,13 @@ class LoadSlave(ArraySlave):
         return {"memory": [mem.state() for mem, _, _ in self.memories]}
 
     def set_physics_state(self, state):
-        for (mem, _, _), s in zip(self.memories, state["memory"]):
+        saved = state["memory"]
+        if len(saved) != len(self.memories):   # taken after initialization and restored before it, or back
+            if saved:
+                self.start_physics()           # the memories, then their saved histories
+            else:
+                self.memories = []
+        for (mem, _, _), s in zip(self.memories, saved):
             mem.set_state(s)
 
 
