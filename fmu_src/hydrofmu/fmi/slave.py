@@ -649,10 +649,13 @@ class DynamicsSlave(ArraySlave):
             rates = loads * 0.0 if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
         if self.solver is not None:   # the group's state is one vector already
-            acc = self.solver.step(dt, loads, rates)
-            self.values[self._motion_vrs] = np.concatenate((self.solver.y, acc.ravel()))
+            acc = self.solver.step(dt, loads, rates).ravel()
+            out = np.concatenate((self.solver.y, acc))
         else:
-            self._publish(self.bodies[0].step(dt, loads, rates))
+            acc = self.bodies[0].step(dt, loads, rates)
+            out = np.concatenate((self.bodies[0]._y, acc))
+        self.values[self._motion_vrs] = out
+        self.checked = len(out) == len(self.output_vrs) and _finite(out.tolist())   # every output, then
 
     def physics_state(self):
         if not hasattr(self, "bodies"):
