@@ -81,7 +81,12 @@ from .state import Motion
 try:   # the gufunc behind np.linalg.solve, without their ~3 µs of wrapping per call
     from numpy.linalg._umath_linalg import solve1 as _solve
 except ImportError:  # pragma: no cover - other numpy layouts
-    _solve = np.linalg.solve
+    def _solve(a, b, out=None):
+        x = np.linalg.solve(a, b)
+        if out is None:
+            return x
+        out[...] = x
+        return out
 
 
 def _finite(x):
@@ -294,7 +299,7 @@ class _Equations:
             acc = _solve(end[1], end[2] + load_end)
         finally:
             quiet.restore(token)
-        if not (_finite(yp) and _finite(acc)):   # a singular matrix, or non-finite loads
+        if not math.isfinite(sum(yp.tolist()) + sum(acc.tolist())):   # a singular matrix, or non-finite loads
             if not checked:
                 return self.integrate(y, load, rate, dt, max_substep, start, checked=True)
             return yp[self.back], None, load_end, acc
@@ -317,7 +322,8 @@ class _Equations:
                 l0 = load + (m * h) * rate if m else load
                 forcing = (base + (m * h) * rate if m else base) + hc * rate
             kin, big0, rhs, _ = start or self.start(yp, signs)
-            stages[0], stages[1, :n6], stages[1, n6:] = yp, kin, _solve(big0, rhs + l0)
+            stages[0], stages[1, :n6] = yp, kin
+            _solve(big0, rhs + l0, out=stages[1, n6:])
             if checked and not _finite(stages[1]):
                 self.check(big0)
             for s in range(1, ns):
@@ -326,7 +332,7 @@ class _Equations:
                 rhs = forcing[s] - kd.dot(ys)
                 rhs -= bias
                 big.put(idx, blocks)
-                acc = stages[s + 1, n6:] = _solve(big, rhs)
+                acc = _solve(big, rhs, out=stages[s + 1, n6:])
                 stages[s + 1, :n6] = kin
                 if checked and not _finite(acc):
                     self.check(big)
