@@ -31,11 +31,12 @@ the joint point and are carried entirely by side A: one call of the lumped kerne
 A's motion, offset = point_a.  Name the side that should carry them A (with the earth
 as B, the node loads the moving body).
 """
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .kinematics import point_velocity, rotation, skew, transfer
+from .kinematics import cross_floats, rotate, rotate_back, rotation, skew
 from .lumped import LumpedBody
 
 
@@ -46,17 +47,29 @@ def log_rotation(rot):
     0/0; beyond π/2 the axis comes from the symmetric part (1 − cos)·n·nᵀ, which stays
     well conditioned up to π, with its sign taken from the skew part.
     """
-    w = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])  # sin·n
-    s, c = np.linalg.norm(w), 0.5 * (np.trace(rot) - 1.0)
-    angle = np.arctan2(s, c)
+    return np.array(_log_rotation(np.asarray(rot, dtype=float).tolist()))
+
+
+def _log_rotation(rows):
+    """``log_rotation`` of a rotation given by its rows of floats: three floats (the joint
+    evaluates it every step; numpy's per-call cost dominates on 3×3)."""
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rows
+    wx, wy, wz = 0.5 * (r21 - r12), 0.5 * (r02 - r20), 0.5 * (r10 - r01)   # sin·n
+    s, c = math.sqrt(wx * wx + wy * wy + wz * wz), 0.5 * (r00 + r11 + r22 - 1.0)
+    angle = math.atan2(s, c)
     if angle < 1e-4:
-        return w * (1.0 + angle * angle / 6.0)  # angle/sin(angle)
-    if c >= 0.0:
-        return w * (angle / s)
-    b = 0.5 * (rot + rot.T) - c * np.eye(3)  # (1 − c)·n·nᵀ
-    k = int(np.argmax(np.diag(b)))
-    n = b[:, k] / np.linalg.norm(b[:, k])
-    return angle * (n if n @ w >= 0.0 else -n)
+        k = 1.0 + angle * angle / 6.0   # angle/sin(angle)
+    elif c >= 0.0:
+        k = angle / s
+    else:   # (1 − c)·n·nᵀ = sym(rot) − c·1: its largest diagonal entry's column is ∥ n
+        cols = ((r00 - c, 0.5 * (r10 + r01), 0.5 * (r20 + r02)),
+                (0.5 * (r01 + r10), r11 - c, 0.5 * (r21 + r12)),
+                (0.5 * (r02 + r20), 0.5 * (r12 + r21), r22 - c))
+        nx, ny, nz = cols[max(range(3), key=lambda i: cols[i][i])]
+        norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+        k = angle / norm if nx * wx + ny * wy + nz * wz >= 0.0 else -angle / norm
+        return nx * k, ny * k, nz * k
+    return wx * k, wy * k, wz * k
 
 
 def initial_relative_rotation(attitude_a, attitude_b=None):
@@ -102,14 +115,6 @@ class BallJoint:
     def uses_acceleration(self):
         return self.node is not None and self.node.uses_acceleration
 
-    def _side_b(self, motion_b):
-        """(rotation, global offset of the point, point position, point velocity, ω) of B."""
-        if motion_b is None:
-            return np.eye(3), np.zeros(3), self.point_b, np.zeros(3), np.zeros(3)
-        rot = motion_b.rot
-        r = rot @ self.point_b
-        return rot, r, motion_b.position + r, point_velocity(motion_b.velocity, r), motion_b.velocity[3:]
-
     def deformation(self, motion_a, motion_b):
         """Gap d = p_B − p_A [m] (global) and rotation vector θ [rad] (A's axes)."""
         return self.loads_and_deformation(motion_a, motion_b, None)[2:]
@@ -121,19 +126,46 @@ class BallJoint:
         return self.loads_and_deformation(motion_a, motion_b, env)[:2]
 
     def loads_and_deformation(self, motion_a, motion_b, env):
-        """(load on A, load on B, gap d, rotation vector θ) in one pass; env None: no node loads."""
-        rot_a = motion_a.rot
-        r_a = rot_a @ self.point_a
-        rot_b, r_b, p_b, v_b, w_b = self._side_b(motion_b)
-        d = p_b - motion_a.position - r_a
-        f = self.k_lin * d + self.c_lin * (v_b - point_velocity(motion_a.velocity, r_a))
-        theta = log_rotation(rot_a.T @ rot_b @ self.r_rel0.T)
-        w_rel = rot_a.T @ (w_b - motion_a.velocity[3:])
-        m = rot_a @ np.where(self.free, 0.0, self.k_rot * theta + self.c_rot * w_rel)
-        load_a = transfer(f, r_a, m)
+        """(load on A, load on B, gap d, rotation vector θ) in one pass; env None: no node
+        loads.  On plain floats: every product here is 3×3 or smaller."""
+        ra_rows = motion_a.rot_rows
+        ax, ay, az = motion_a.position.tolist()
+        vax, vay, vaz, wax, way, waz = motion_a.velocity.tolist()
+        rax, ray, raz = rotate(ra_rows, *self.point_a.tolist())
+        if motion_b is None:   # the earth: the point is global and still
+            rb_rows, (rbx, rby, rbz) = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0)
+            pbx, pby, pbz = self.point_b.tolist()
+            vbx = vby = vbz = wbx = wby = wbz = 0.0
+        else:
+            rb_rows = motion_b.rot_rows
+            rbx, rby, rbz = rotate(rb_rows, *self.point_b.tolist())
+            bx, by, bz = motion_b.position.tolist()
+            pbx, pby, pbz = bx + rbx, by + rby, bz + rbz
+            vbx, vby, vbz, wbx, wby, wbz = motion_b.velocity.tolist()
+            cx, cy, cz = cross_floats(wbx, wby, wbz, rbx, rby, rbz)
+            vbx, vby, vbz = vbx + cx, vby + cy, vbz + cz
+        dx, dy, dz = pbx - ax - rax, pby - ay - ray, pbz - az - raz
+        cx, cy, cz = cross_floats(wax, way, waz, rax, ray, raz)   # A's point moves at v_A + ω_A × r_A
+        k, c = self.k_lin, self.c_lin
+        fx, fy, fz = (k * dx + c * (vbx - vax - cx), k * dy + c * (vby - vay - cy),
+                      k * dz + c * (vbz - vaz - cz))
+        # R_def = R_Aᵀ·R_B·R_rel0ᵀ, row by row
+        ra_cols = tuple(zip(*ra_rows))
+        ab = [rotate_back(rb_rows, *col) for col in ra_cols]  # row i of R_Aᵀ·R_B: R_Bᵀ·(column i of R_A)
+        r0 = self.r_rel0.tolist()
+        rdef = [rotate(r0, *row) for row in ab]               # (R_rel0·rowᵀ)ᵀ = row·R_rel0ᵀ
+        theta = _log_rotation(rdef)
+        w_rel = rotate_back(ra_rows, wbx - wax, wby - way, wbz - waz)
+        kr, cr = self.k_rot, self.c_rot
+        mb = [0.0 if free else kr * t + cr * w for free, t, w in zip(self.free.tolist(), theta, w_rel)]
+        mx, my, mz = rotate(ra_rows, *mb)
+        ux, uy, uz = cross_floats(rax, ray, raz, fx, fy, fz)
+        tx, ty, tz = cross_floats(rbx, rby, rbz, fx, fy, fz)
+        load_a = np.array((fx, fy, fz, ux + mx, uy + my, uz + mz))
         if self.node is not None and env is not None:
-            load_a = load_a + self.node.load(motion_a, env)
-        return load_a, transfer(-f, r_b, -m), d, theta
+            load_a += self.node.load(motion_a, env)
+        return (load_a, np.array((-fx, -fy, -fz, -tx - mx, -ty - my, -tz - mz)), np.array((dx, dy, dz)),
+                np.array(theta))
 
     def mass_matrix(self, motion_a):
         """6×6 mass of the node about A's reference point (zeros without a node)."""
