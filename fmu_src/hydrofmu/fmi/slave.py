@@ -707,14 +707,16 @@ class ConnectorSlave(ArraySlave):
 
     def evaluate(self):
         self.stale = False
-        if not self.check_finite(self.inputs):
-            return
+        if self.suspect:   # an input set since the last check may be non-finite
+            if not self.check_finite(self.inputs):
+                return
+            self.suspect = False
         a = self.motion(self.side_a)
         b = self.motion(self.side_b) if self.side_b else None
         load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, self.env())
         if self.joint.uses_acceleration:
             if self.explicit:
-                load_a = load_a - self.joint.mass_matrix(a) @ a.acceleration
+                load_a = load_a - self.joint.mass_matrix(a).dot(a.acceleration)
             load_a = load_a + self.joint.velocity_load(a)
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
