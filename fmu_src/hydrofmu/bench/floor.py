@@ -13,7 +13,8 @@ of what the same master pays for the same number of FMUs that do nothing:
 - cost per step: the stepping loop of ``master.run`` (startup excluded).
 
 Each candidate is timed right after its floor, in ``rounds`` rounds (floor, scene, floor,
-scene, …); each multiple is the median of the rounds' ratios, and a multiple whose spread
+scene, …; all the startups first, then all the stepping loops, so that a fresh process does not
+disturb the loop timed after it); each multiple is the median of the rounds' ratios, and a multiple whose spread
 between rounds, (max − min)/median, is above ``NOISY`` is reported as too noisy instead of
 as a number.
 """
@@ -134,10 +135,14 @@ def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05):
     than a long stepping loop, and one must not hide the other."""
     floors = {n: floor_system(out, floor_fmu, n, step) for n in sorted({fmu_count(f) for f in candidates.values()})}
     got = {label: [] for label in candidates}
+    # the startups (fresh processes) in rounds of their own, then the stepping loops: a loop
+    # timed right after a process start varied by a third between rounds, apart by a few per cent
     for _ in range(rounds):
         for label, folder in candidates.items():
-            fl = floors[fmu_count(folder)]
-            got[label].append((startup(fl), startup(folder), per_step(fl, steps, step), per_step(folder, steps, step)))
+            got[label].append([startup(floors[fmu_count(folder)]), startup(folder)])
+    for k in range(rounds):
+        for label, folder in candidates.items():
+            got[label][k] += [per_step(floors[fmu_count(folder)], steps, step), per_step(folder, steps, step)]
     rows = []
     for label, folder in candidates.items():
         t = np.array(got[label])
