@@ -244,13 +244,13 @@ class _Equations:
 
     def start(self, yp, signs=None):
         """What a step needs at the reordered state yp, whatever the load: (kinematic
-        rates, M_rb + A, right-hand side without the load, signs of cos θ).  The
+        rates, M_rb + A, right-hand side without the load, signs of cos θ, yp).  The
         acceleration under a load L is then (M_rb + A)⁻¹·(rhs + L): the published
         acceleration of one step and the first stage of the next one share it."""
         blocks, bias, kin, signs = self.parts(yp.tolist(), signs)
         rhs = self.k_eta0 - self.kd.dot(yp)   # .dot: a third of @'s cost on small arrays
         rhs -= bias
-        return kin, self.matrix(blocks), rhs, signs
+        return kin, self.matrix(blocks), rhs, signs, yp
 
     def accelerations(self, y, load, start=None):
         """[a; α] of every body (6n,) at state y under ``load`` (``start``: ``self.start``
@@ -268,13 +268,13 @@ class _Equations:
     def table(self, h, method):
         """RK coefficients of ``method`` (RK4 or RK6) for an internal step h: rows
         [1, h·a_s] per stage, [1, h·b], and the stages' times h·c as a column."""
-        t = self._tables.get((h, len(method[1])))
+        t = self._tables.get((h, method is RK4))
         if t is None:
             ra, rb, rc = method
             a = np.zeros((len(rb), len(rb) + 1))
             a[:, 0], a[:, 1:] = 1.0, h * ra
             b = np.concatenate([[1.0], h * rb])
-            t = self._tables[(h, len(rb))] = (a, b, (h * rc)[:, None])
+            t = self._tables[(h, method is RK4)] = (a, b, (h * rc)[:, None])
             if len(self._tables) > 8:
                 self._tables.pop(next(iter(self._tables)))
         return t
@@ -288,9 +288,9 @@ class _Equations:
             method, n = RK4, 1
         else:
             method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
-        yp = y[self.order] if self.n > 1 else y   # (one body: the order is [η; ν] already)
-        if start is None:
-            start = self.start(yp)
+        if start is None:   # (one body: the order is [η; ν] already)
+            start = self.start(y[self.order] if self.n > 1 else y)
+        yp = start[4]
         token = quiet.off()   # a non-finite result is checked below
         try:
             yp = self._steps(yp, load, rate, dt / n, n, start, method, checked)
@@ -321,7 +321,7 @@ class _Equations:
             else:   # the load at the step's start and at each stage's time
                 l0 = load + (m * h) * rate if m else load
                 forcing = (base + (m * h) * rate if m else base) + hc * rate
-            kin, big0, rhs, _ = start or self.start(yp, signs)
+            kin, big0, rhs = (start or self.start(yp, signs))[:3]
             stages[0], stages[1, :n6] = yp, kin
             _solve(big0, rhs + l0, out=stages[1, n6:])
             if checked and not _finite(stages[1]):
@@ -510,7 +510,8 @@ class CoupledBodies:
         y, end = (last[0], last[2]) if last else (np.concatenate([b._y for b in self.bodies]), None)
         acc = None
         if dt > 0.0:
-            rates = None if rates is None else np.asarray(rates, dtype=float).reshape(-1)
+            if rates is not None and not (type(rates) is np.ndarray and rates.ndim == 1):
+                rates = np.asarray(rates, dtype=float).reshape(-1)
             y, end, loads, acc = self._eq.integrate(y, loads, rates, dt, self.max_substep, end)
         self.y = y   # every body's [η; ν], one after the other (the bodies hold views of it)
         held = []
