@@ -112,7 +112,8 @@ def test_floor_fmu_copies_its_inputs(tmp_path):
     assert before == [0.0] * 6 and after == u   # not before the step
     folder = floor.floor_system(tmp_path, fmu, 3)
     assert floor.fmu_count(folder) == 3
-    assert floor.per_step(folder, 20, 0.05) > 0 and floor.startup(folder) > 0
+    assert floor.per_step(folder, 20, 0.05) > 0 and floor.per_step(folder, 20, 0.05, fresh=True) > 0
+    assert floor.startup(folder) > 0
     names, _, after = floor_steps(floor.build_floor(tmp_path / "sized", 4, 2), [1.0, 2.0, 3.0, 4.0])
     assert names == ["u[1]", "u[2]", "u[3]", "u[4]", "y[1]", "y[2]"] and after == [1.0, 2.0]
 

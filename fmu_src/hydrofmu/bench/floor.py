@@ -10,11 +10,11 @@ of what the same master pays for the same number of FMUs that do nothing:
 - startup: load, instantiate and initialise every FMU (``master.load`` + ``initialize``)
   in a fresh Python process that has imported fmpy and numpy (a host's first FMU pays the
   runtime's imports, as it would);
-- cost per step: the stepping loop of ``master.run`` (startup excluded).
+- cost per step: the stepping loop of ``master.run`` (startup excluded), also in a process
+  of its own.
 
 Each candidate is timed right after its floor, in ``rounds`` rounds (floor, scene, floor,
-scene, …; all the startups first, then all the stepping loops, so that a fresh process does not
-disturb the loop timed after it); each multiple is the median of the rounds' ratios, and a multiple whose spread
+scene, …; all the startups first, then all the stepping loops); each multiple is the median of the rounds' ratios, and a multiple whose spread
 between rounds, (max − min)/median, is above ``NOISY`` is reported as too noisy instead of
 as a number.
 """
@@ -65,6 +65,12 @@ print(json.dumps(t1 - t0))
 '''
 
 
+STEPPING = '''import json, sys
+from hydrofmu.bench.floor import per_step
+print(json.dumps(per_step(sys.argv[1], int(sys.argv[2]), float(sys.argv[3]))))
+'''
+
+
 def build_floor(folder, n_in=6, n_out=6):
     """Build the trivial FMU (``n_in`` inputs, ``n_out`` outputs) into ``folder``; returns its path."""
     from pythonfmu.builder import FmuBuilder
@@ -106,8 +112,13 @@ def startup(folder):
     return float(out.stdout.strip().splitlines()[-1])
 
 
-def per_step(folder, steps, step):
-    """Seconds per communication step of ``master.run`` (its stepping loop only)."""
+def per_step(folder, steps, step, fresh=False):
+    """Seconds per communication step of ``master.run`` (its stepping loop only); ``fresh``:
+    in a process of its own, so that no loop inherits the heap and caches of those before."""
+    if fresh:
+        out = subprocess.run([sys.executable, "-c", STEPPING, str(folder), str(steps), str(step)],
+                             capture_output=True, text=True, check=True)
+        return float(out.stdout.strip().splitlines()[-1])
     from ..cosim.master import run
     marks = {}
 
@@ -135,14 +146,14 @@ def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05):
     than a long stepping loop, and one must not hide the other."""
     floors = {n: floor_system(out, floor_fmu, n, step) for n in sorted({fmu_count(f) for f in candidates.values()})}
     got = {label: [] for label in candidates}
-    # the startups (fresh processes) in rounds of their own, then the stepping loops: a loop
-    # timed right after a process start varied by a third between rounds, apart by a few per cent
+    # the startups in rounds of their own, then the stepping loops, each in a process of its
+    # own: a loop timed in the process that ran the others varied by a third between rounds
     for _ in range(rounds):
         for label, folder in candidates.items():
             got[label].append([startup(floors[fmu_count(folder)]), startup(folder)])
     for k in range(rounds):
         for label, folder in candidates.items():
-            got[label][k] += [per_step(floors[fmu_count(folder)], steps, step), per_step(folder, steps, step)]
+            got[label][k] += [per_step(f, steps, step, fresh=True) for f in (floors[fmu_count(folder)], folder)]
     rows = []
     for label, folder in candidates.items():
         t = np.array(got[label])

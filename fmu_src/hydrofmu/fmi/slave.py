@@ -94,21 +94,24 @@ LIN_ROT = {
 MASS_UNITS = [["kg"] * 3 + ["kg.m"] * 3] * 3 + [["kg.m"] * 3 + ["kg.m2"] * 3] * 3
 
 
-def guarded(fallback=None):
+def guarded(fallback=None, computes=True):
     """An FMI entry point that never raises: an exception is logged as an error (the shim
     then returns fmi2Error) and ``fallback(self, *args)`` is returned instead.  Floating-
-    point warnings are off inside (non-finite results are checked, not warned)."""
+    point warnings are off inside (non-finite results are checked, not warned), unless the
+    entry point ``computes`` nothing (fmi2SetReal, a read of values already computed): the
+    context variable costs ~0.4 µs per call on the per-step path."""
     def wrap(method):
         @functools.wraps(method)
         def call(self, *args):
-            token = quiet.off()
+            token = quiet.off() if computes else None
             try:
                 return method(self, *args)
             except Exception as exc:
                 self.fail(f"{method.__name__}: {type(exc).__name__}: {exc}")
                 return fallback(self, *args) if fallback else None
             finally:
-                quiet.restore(token)
+                if token is not None:
+                    quiet.restore(token)
         return call
     return wrap
 
@@ -284,11 +287,15 @@ class ArraySlave(Fmi2Slave):
         self._vr_last[call] = (list(key), known)
         return known
 
-    @guarded(lambda self, vrs: [math.nan] * len(vrs))
+    @guarded(lambda self, vrs: [math.nan] * len(vrs), computes=False)
     def get_real(self, vrs):
         idx = self._refs(vrs, "get")[0]
-        if self.stale:
-            self.evaluate()
+        if self.stale:   # the one computing case: warnings off around it
+            token = quiet.off()
+            try:
+                self.evaluate()
+            finally:
+                quiet.restore(token)
         if self.error is not None:   # kept: the next fmi2DoStep fails on it too
             self.fail(self.error)
             return self.values[idx].tolist()
@@ -297,7 +304,7 @@ class ArraySlave(Fmi2Slave):
             self.check_outputs(idx)
         return out
 
-    @guarded()
+    @guarded(computes=False)
     def set_real(self, vrs, values):
         idx, settable, settable_running = self._refs(vrs, "set")
         if not (settable_running if self.running else settable):
