@@ -164,8 +164,12 @@ def test_lost_worker_is_recorded_and_rerun(client, tmp_path):
         table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
     finally:
         client.run(exec, HEAL, {})
-    assert list(table["status"]) == ["ok", "lost", "ok"]
-    assert "KilledWorker" in table["error"].iloc[1]
+    # the killer's case is lost; a case the scheduler had queued on the same worker dies with
+    # it (allowed-failures = 0 here; Dask's default retries it elsewhere), every other runs
+    status = list(table["status"])
+    assert status[1] == "lost" and "KilledWorker" in table["error"].iloc[1]
+    assert set(status) == {"ok", "lost"} and status.count("ok") >= 1
+    assert all(e for e, s in zip(table["error"], status) if s == "lost")   # each says why
     client.wait_for_workers(2, timeout=60)   # the nanny restarts the dead worker
     again = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
     assert (again["status"] == "ok").all() and list(again["case"]) == list(table["case"])

@@ -1,6 +1,7 @@
 """Rigid-body dynamics partner against independent references: analytic oscillators,
 a quaternion Newton–Euler model about the CoG solved with scipy, conservation laws,
-and the exact rotation of a spherical top."""
+and the exact rotation of a spherical top.  Every test runs twice: through the C kernel
+(physics/rigid.c, the default where it compiles) and through the Python equations."""
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -12,6 +13,17 @@ from hydrofmu.physics.kinematics import rotation
 from hydrofmu.physics.rigid_body import GimbalLockError, RigidBody
 
 ZERO6 = np.zeros(6)
+
+
+@pytest.fixture(autouse=True, params=["c", "python"])
+def kernel(request, monkeypatch):
+    """Which implementation steps the bodies of the test."""
+    from hydrofmu.physics import rigid_kernel
+    if request.param == "python":
+        monkeypatch.setattr(rigid_kernel, "library", lambda: None)
+    elif rigid_kernel.library() is None:
+        pytest.skip("no C compiler for the rigid-body kernel")
+    return request.param
 
 
 def msd(t, m, k, c, x0, v0, force=0.0):

@@ -34,6 +34,8 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # fmi/slave.py (every one, module level or not), found in the sources.
 RUNTIME_ENTRY = "fmi/slave.py"
 RUNTIME_INIT = '"""hydrofmu FMU runtime: physics kernels, slaves, typed description, errors."""\n'
+# C sources the runtime carries compiled, where its Python finds them (physics/rigid_kernel.py)
+RUNTIME_C = {"physics/rigid.c": "physics/_rigid.so"}
 
 
 def _module_file(name):
@@ -77,17 +79,20 @@ def runtime_files():
 def runtime_name():
     """'hydrofmu_rt_<hash>': the runtime copy's name, from the hash of its sources."""
     h = hashlib.sha256(RUNTIME_INIT.encode())
-    for f in runtime_files():
+    for f in runtime_files() + sorted(Path(c) for c in RUNTIME_C):
         h.update(f.as_posix().encode())
         h.update((PACKAGE / f).read_bytes())
     return f"hydrofmu_rt_{h.hexdigest()[:10]}"
 
 
 def copy_runtime(dest):
-    """Copy the runtime into ``dest`` (a package folder of its own)."""
+    """Copy the runtime into ``dest`` (a package folder of its own), its C parts compiled."""
+    from ..cc import cached
     for f in runtime_files():
         (dest / f).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(PACKAGE / f, dest / f)
+    for src, lib in RUNTIME_C.items():
+        shutil.copyfile(cached(PACKAGE / src), dest / lib)
     (dest / "__init__.py").write_text(RUNTIME_INIT)
 
 

@@ -24,11 +24,8 @@ Discard mapping).
 
 from __future__ import annotations
 
-import hashlib
 import os
-import shlex
 import shutil
-import subprocess
 import sys
 import sysconfig
 import tempfile
@@ -37,8 +34,9 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from .. import cc
+
 SOURCE = Path(__file__).with_name("shim.c")
-FLAGS = ["-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=c99"]
 LIBS = ["-ldl", "-lpthread"]  # after the source: link order matters with --as-needed
 INNER_SUFFIX = "_pythonfmu.so"
 PLATFORM_DIR = "binaries/linux64"
@@ -47,53 +45,14 @@ ENV = "HYDROFMU_PYTHON"  # names another interpreter for the FMUs (read by shim.
 
 
 def _compiler() -> list[str]:
-    """The C compiler command: $CC if set, else `cc`, else `gcc`."""
-    env = os.environ.get("CC")
-    if env and shutil.which(shlex.split(env)[0]):
-        return shlex.split(env)
-    for name in ("cc", "gcc"):
-        path = shutil.which(name)
-        if path:
-            return [path]
-    raise RuntimeError(
-        "hydrofmu needs a C compiler to build its FMI shim, but neither $CC, `cc` nor `gcc` "
-        "was found on PATH; install one (e.g. `apt-get install gcc`)"
-    )
-
-
-def _cache_dir() -> Path:
-    """Where compiled shims are kept: $HYDROFMU_CACHE, else $XDG_CACHE_HOME/hydrofmu, else ~/.cache/hydrofmu."""
-    root = os.environ.get("HYDROFMU_CACHE")
-    if root:
-        return Path(root)
-    xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(xdg) / "hydrofmu"
+    return cc.compiler()
 
 
 def _cached_shim() -> Path:
-    """Compile shim.c once per source/flags hash and return the cached library."""
+    """shim.c compiled once per source/flags hash (``hydrofmu.cc``): the cached library."""
     if not sys.platform.startswith("linux"):
         raise RuntimeError(f"the hydrofmu FMI shim is built for Linux only, not {sys.platform}")
-    src = SOURCE.read_bytes()
-    key = hashlib.sha256(src + " ".join(FLAGS + LIBS).encode()).hexdigest()[:16]
-    lib = _cache_dir() / f"shim-{key}.so"
-    if lib.is_file():
-        return lib
-    lib.parent.mkdir(parents=True, exist_ok=True)
-    cc = _compiler()
-    # Compile to a private name, then rename: concurrent builds never see a partial file.
-    fd, tmp = tempfile.mkstemp(prefix=lib.stem + ".", suffix=".so.tmp", dir=lib.parent)
-    os.close(fd)
-    try:
-        run = subprocess.run(cc + FLAGS + [str(SOURCE), "-o", tmp] + LIBS,
-                             capture_output=True, text=True)
-        if run.returncode != 0:
-            raise RuntimeError(f"compiling {SOURCE} with {cc[0]} failed:\n{run.stderr.strip()}")
-        os.replace(tmp, lib)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return lib
+    return cc.cached(SOURCE, LIBS)
 
 
 def compile_shim(out_path) -> Path:

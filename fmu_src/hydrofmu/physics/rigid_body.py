@@ -75,7 +75,7 @@ import numpy as np
 
 from ..admissible import inertia as inertia_problems
 from ..errors import InputError
-from . import quiet
+from . import quiet, rigid_kernel
 from .state import Motion
 
 try:   # the gufunc behind np.linalg.solve, without their ~3 µs of wrapping per call
@@ -118,6 +118,9 @@ def _gimbal_message(attitude):
     phi, theta, psi = np.degrees(attitude)
     return (f"pitch θ = {theta:.4f}° reached ±90° (roll {phi:.4f}°, yaw {psi:.4f}°): the "
             "ZYX Euler-angle rates are singular there; the rigid body cannot go on")
+
+
+NO_START = ()   # the start of a state the C kernel stepped to: not computed, empty (false)
 
 
 class _Equations:
@@ -168,6 +171,10 @@ class _Equations:
         self.first = bodies[0]   # names the body in a singular-matrix error
         self._tables = {}
         self._big = self.const.copy()   # the stages' mass matrix (rotating entries put anew in each)
+        lib = rigid_kernel.library()
+        self.kernel = None if lib is None else rigid_kernel.Kernel(
+            lib, [[m, 1.0 if cog else 0.0, *(cog or (0.0, 0.0, 0.0)), *io_b] for m, cog, io_b, *_ in self.props],
+            self.const, kd, self.k_eta0)
 
     def parts(self, yl, signs=None):
         """Rotating mass-matrix entries (constant part included, at ``block_idx``), bias
@@ -281,14 +288,20 @@ class _Equations:
 
     def integrate(self, y, load, rate, dt, max_substep, start=None, checked=False):
         """(state after dt [s] > 0 from y under load + rate·t (rate None: held load),
-        ``start`` of that state, the load at the end of the step and the accelerations
-        there under it).  ``start``: ``self.start`` of y, if known.  A result that is not
-        finite is computed again ``checked``: a singular matrix raises InputError."""
+        ``start`` of that state (NO_START from the C kernel), the load at the end of the
+        step and the accelerations there under it).  ``start``: ``self.start`` of y, if
+        known.  The C kernel (physics.rigid_kernel) takes the step when there is one; a step it
+        cannot finish, and a result that is not finite, is computed again here,
+        ``checked``: a gimbal lock raises GimbalLockError, a singular matrix InputError."""
         if dt <= max_substep * (1.0 + 1e-12):   # 1e-12: round-off
             method, n = RK4, 1
         else:
             method, n = RK6, max(1, math.ceil(dt / (STEP_RATIO * max_substep) * (1.0 - 1e-12)))
-        if start is None:   # (one body: the order is [η; ν] already)
+        if self.kernel is not None and not checked:
+            got = self.kernel.steps(y, load, rate, dt / n, n, method)
+            if type(got) is tuple:
+                return got[0], NO_START, (load if rate is None else load + dt * rate), got[1]
+        if not start:   # (one body: the order is [η; ν] already)
             start = self.start(y[self.order] if self.n > 1 else y)
         yp = start[4]
         token = quiet.off()   # a non-finite result is checked below
