@@ -9,7 +9,8 @@ of what the same master pays for the same number of FMUs that do nothing:
 
 - startup: load, instantiate and initialise every FMU (``master.load`` + ``initialize``)
   in a fresh Python process that has imported fmpy and numpy (a host's first FMU pays the
-  runtime's imports, as it would);
+  runtime's imports, as it would), the best of ``STARTUP_BEST`` such processes in each
+  round (a ~0.1 s process start on a shared machine varied by half between rounds);
 - cost per step: the stepping loop of ``master.run`` (startup excluded), also in a process
   of its own.
 
@@ -28,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 NOISY = 0.25   # spread between rounds above which a figure is not trusted
+STARTUP_BEST = 3   # fresh processes per startup figure of a round, the best kept
 
 FLOOR_SCRIPT = '''"""The pythonfmu floor: {n_in} inputs, {n_out} outputs, do_step copies inputs to outputs."""
 from pythonfmu import Fmi2Causality, Fmi2Slave, Real
@@ -106,10 +108,14 @@ def fmu_count(folder):
     return len(json.loads((Path(folder) / "manifest.json").read_text())["order"])
 
 
-def startup(folder):
-    """Seconds to load, instantiate and initialise every FMU of a run folder, in a fresh process."""
-    out = subprocess.run([sys.executable, "-c", STARTUP, str(folder)], capture_output=True, text=True, check=True)
-    return float(out.stdout.strip().splitlines()[-1])
+def startup(folder, best_of=1):
+    """Seconds to load, instantiate and initialise every FMU of a run folder, in a fresh
+    process; the best of ``best_of`` processes (a process start's noise only adds time)."""
+    times = []
+    for _ in range(best_of):
+        out = subprocess.run([sys.executable, "-c", STARTUP, str(folder)], capture_output=True, text=True, check=True)
+        times.append(float(out.stdout.strip().splitlines()[-1]))
+    return min(times)
 
 
 def per_step(folder, steps, step, fresh=False):
@@ -135,10 +141,11 @@ def spread(values):
     return float((v.max() - v.min()) / np.median(v))
 
 
-def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05):
+def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05, best_of=STARTUP_BEST):
     """Startup and cost per step of each run folder in ``candidates`` ({label: folder})
     against n floor FMUs (n = its FMU count), measured back to back in each of ``rounds``
-    rounds, so that a slow spell of the machine hits both.  Rows {label, fmus, startup_s,
+    rounds (each startup the best of ``best_of`` processes), so that a slow spell of the
+    machine hits both.  Rows {label, fmus, startup_s,
     startup_floor_s, startup_x, step_us, step_floor_us, step_x (medians over the rounds;
     the multiples are medians of each round's ratio), startup_spread and step_spread: the
     relative spread of each multiple between rounds, startup_noisy and step_noisy: that
@@ -150,7 +157,7 @@ def compare(candidates, floor_fmu, out, rounds=5, steps=400, step=0.05):
     # own: a loop timed in the process that ran the others varied by a third between rounds
     for _ in range(rounds):
         for label, folder in candidates.items():
-            got[label].append([startup(floors[fmu_count(folder)]), startup(folder)])
+            got[label].append([startup(floors[fmu_count(folder)], best_of), startup(folder, best_of)])
     for k in range(rounds):
         for label, folder in candidates.items():
             got[label][k] += [per_step(f, steps, step, fresh=True) for f in (floors[fmu_count(folder)], folder)]
