@@ -7,6 +7,22 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 
+# script lines for a fresh interpreter: FMU (a path) loaded with fmpy, instantiated,
+# initialised and stepped once as ``s`` (extracted to ``unzipped``)
+STEP_ONCE = """
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+md = read_model_description(FMU)
+unzipped = extract(FMU)
+s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, instanceName="x",
+              modelIdentifier=md.coSimulation.modelIdentifier)
+s.instantiate()
+s.setupExperiment(startTime=0.0)
+s.enterInitializationMode()
+s.exitInitializationMode()
+s.doStep(0.0, 0.05)
+"""
+
 
 def write_scene(folder, text, name="scene.toml"):
     path = Path(folder) / name

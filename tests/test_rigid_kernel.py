@@ -16,7 +16,7 @@ from hydrofmu.errors import InputError
 from hydrofmu.physics import rigid_kernel
 from hydrofmu.physics.rigid_body import CoupledBodies, GimbalLockError, RigidBody
 
-from conftest import ROOT
+from conftest import ROOT, STEP_ONCE
 
 if rigid_kernel.library() is None:
     pytest.skip("no C compiler for the rigid-body kernel", allow_module_level=True)
@@ -98,22 +98,15 @@ def test_without_a_compiler_everything_runs_in_python(tmp_path, monkeypatch):
 
 FRESH = """
 import sys
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
-md = read_model_description(sys.argv[1])
-unzipped = extract(sys.argv[1])
-s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, instanceName="x",
-              modelIdentifier=md.coSimulation.modelIdentifier)
-s.instantiate()
-s.setupExperiment(startTime=0.0)
-s.enterInitializationMode()
-s.exitInitializationMode()
-s.doStep(0.0, 0.05)
+FMU = sys.argv[1]
+""" + STEP_ONCE + """
 kernel = [m for name, m in sys.modules.items() if name.endswith(".physics.rigid_kernel")]
 lib = kernel[0]._lib[0]
 print(lib is not None and lib._name == str(kernel[0].BUILT))
 s.terminate()
 s.freeInstance()
+import shutil
+shutil.rmtree(unzipped)
 """
 
 
