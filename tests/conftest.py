@@ -39,6 +39,24 @@ def build(folder, text, name="scene.toml"):
     return build_scene(scene, Path(folder) / "fmus", log=lambda *_: None)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def scratch(tmp_path_factory):
+    """Temporary files of the session (fmpy extracts every FMU it loads, and not every test
+    frees it) under pytest's own base folder, which keeps only the last three sessions;
+    TMPDIR too, for the fresh interpreters the tests start."""
+    import os
+    import tempfile
+    folder = str(tmp_path_factory.mktemp("scratch"))
+    saved = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir, os.environ["TMPDIR"] = folder, folder
+    yield folder
+    tempfile.tempdir = saved[0]
+    if saved[1] is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = saved[1]
+
+
 @pytest.fixture(scope="session")
 def demo_build(tmp_path_factory):
     """The demo scene of models/, built once per session."""
