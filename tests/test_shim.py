@@ -33,10 +33,11 @@ from fmpy.fmi2 import (  # noqa: E402
 fmi2LastSuccessfulTime = 2  # fmi2StatusKind
 from fmpy.validation import validate_fmu  # noqa: E402
 
+from hydrofmu import cc  # noqa: E402
 from hydrofmu.fmi import shim  # noqa: E402
 
 try:
-    shim._compiler()
+    cc.compiler()
 except RuntimeError:
     pytest.skip("no C compiler", allow_module_level=True)
 

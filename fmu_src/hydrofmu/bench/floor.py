@@ -108,23 +108,23 @@ def fmu_count(folder):
     return len(json.loads((Path(folder) / "manifest.json").read_text())["order"])
 
 
+def _child(script, *args):
+    """The number a ``script`` prints last, run in a fresh Python process with ``args``."""
+    out = subprocess.run([sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True, check=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
 def startup(folder, best_of=1):
     """Seconds to load, instantiate and initialise every FMU of a run folder, in a fresh
     process; the best of ``best_of`` processes (a process start's noise only adds time)."""
-    times = []
-    for _ in range(best_of):
-        out = subprocess.run([sys.executable, "-c", STARTUP, str(folder)], capture_output=True, text=True, check=True)
-        times.append(float(out.stdout.strip().splitlines()[-1]))
-    return min(times)
+    return min(_child(STARTUP, folder) for _ in range(best_of))
 
 
 def per_step(folder, steps, step, fresh=False):
     """Seconds per communication step of ``master.run`` (its stepping loop only); ``fresh``:
     in a process of its own, so that no loop inherits the heap and caches of those before."""
     if fresh:
-        out = subprocess.run([sys.executable, "-c", STEPPING, str(folder), str(steps), str(step)],
-                             capture_output=True, text=True, check=True)
-        return float(out.stdout.strip().splitlines()[-1])
+        return _child(STEPPING, folder, steps, step)
     from ..cosim.master import run
     marks = {}
 

@@ -44,10 +44,6 @@ RECORD = "resources/hydrofmu_python.txt"
 ENV = "HYDROFMU_PYTHON"  # names another interpreter for the FMUs (read by shim.c)
 
 
-def _compiler() -> list[str]:
-    return cc.compiler()
-
-
 def _cached_shim() -> Path:
     """shim.c compiled once per source/flags hash (``hydrofmu.cc``): the cached library."""
     if not sys.platform.startswith("linux"):

@@ -8,7 +8,8 @@
  * Python, which raises the error the user sees.
  *
  * Layout, n bodies, N = 6n:
- *   model = [n, props (11 per body), const (N*N), kd (N*2N), k_eta0 (N)]
+ *   model = [n, gimbal_tol, props (11 per body), const (N*N), kd (N*2N), k_eta0 (N)]
+ *     gimbal_tol: |cos(theta)| below which the Euler-angle rates are singular (rigid_body.py)
  *     props: m, has_cog, cx, cy, cz, I00, I01, I02, I11, I12, I22 (inertia about O, body axes)
  *     const: the constant mass matrix (added mass, m*1), row-major
  *     kd:    [K | D] per body on the natural state order, K*eta + D*nu = kd*y
@@ -20,7 +21,6 @@
 #include <string.h>
 
 #define EXPORT __attribute__((visibility("default")))
-#define GIMBAL_TOL 1e-6
 
 enum { HF_OK = 0, HF_GIMBAL = 1, HF_NONFINITE = 2 };
 
@@ -60,12 +60,12 @@ static int solve(int N, double *a, double *b) {
 /*
  * dy = [eta rates; accelerations] of every body at state y under `force` (the load plus
  * K*eta0).  signs: the sign of cos(theta) of each body at the step's start (NULL: now);
- * a cos(theta) below GIMBAL_TOL on that side is HF_GIMBAL.
+ * a cos(theta) below gimbal_tol on that side is HF_GIMBAL.
  */
 static int deriv(const double *model, const double *force, const double *signs, const double *y,
                  double *dy, double *mat, double *rhs) {
     int n = (int)model[0], N = 6 * n;
-    const double *props = model + 1, *cnst = props + 11 * n, *kd = cnst + N * N;
+    const double gimbal_tol = model[1], *props = model + 2, *cnst = props + 11 * n, *kd = cnst + N * N;
     memcpy(mat, cnst, sizeof(double) * N * N);
     for (int r = 0; r < N; r++) {   /* rhs = K*eta0 + load - [K | D]*y */
         double s = force[r];
@@ -78,7 +78,7 @@ static int deriv(const double *model, const double *force, const double *signs, 
         double m = p[0], cf = cos(eta[3]), sf = sin(eta[3]), ct = cos(eta[4]), st = sin(eta[4]);
         double cp = cos(eta[5]), sp = sin(eta[5]);
         double sign = signs ? signs[i] : (ct > 0.0 ? 1.0 : -1.0);
-        if (!(ct * sign >= GIMBAL_TOL)) return HF_GIMBAL;
+        if (!(ct * sign >= gimbal_tol)) return HF_GIMBAL;
         /* R = Rz(psi) Ry(theta) Rx(phi) */
         double R[3][3] = {{cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf},
                           {sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf},
@@ -135,7 +135,7 @@ static int deriv(const double *model, const double *force, const double *signs, 
 EXPORT int hf_rigid_steps(const double *model, const double *table, int steps, const double *load,
                           const double *rate, double *y, double *acc, double *work) {
     int n = (int)model[0], N = 6 * n, ns = (int)table[0];
-    const double h = table[1], *a = table + 2, *b = a + ns * ns, *c = b + ns, *k_eta0 = model + 1 + 11 * n + 3 * N * N;
+    const double h = table[1], *a = table + 2, *b = a + ns * ns, *c = b + ns, *k_eta0 = model + 2 + 11 * n + 3 * N * N;
     double *mat = work, *rhs = mat + N * N, *force = rhs + N, *signs = force + N, *ys = signs + N;
     double *k = ys + 2 * N;   /* ns stage derivatives of 2N each */
     for (int i = 0; i < n; i++) signs[i] = cos(y[12 * i + 4]) > 0.0 ? 1.0 : -1.0;

@@ -176,7 +176,7 @@ class _Equations:
         self._big = self.const.copy()   # the stages' mass matrix (rotating entries put anew in each)
         lib = rigid_kernel.library()
         self.kernel = None if lib is None else rigid_kernel.Kernel(
-            lib, [[m, 1.0 if cog else 0.0, *(cog or (0.0, 0.0, 0.0)), *io_b] for m, cog, io_b, *_ in self.props],
+            lib, GIMBAL_TOL, [[m, 1.0 if cog else 0.0, *(cog or (0.0, 0.0, 0.0)), *io_b] for m, cog, io_b, *_ in self.props],
             self.const, kd, self.k_eta0)
 
     def parts(self, yl, signs=None):

@@ -55,15 +55,16 @@ def _address(a):
 
 
 class Kernel:
-    """hf_rigid_steps bound to the constants of n bodies (rigid.c's layout): ``props``
+    """hf_rigid_steps bound to the constants of n bodies (rigid.c's layout): ``gimbal_tol``
+    (rigid_body.GIMBAL_TOL), ``props``
     (n, 11) [m, has_cog, c (3), I_O (6: xx, xy, xz, yy, yz, zz)], ``const`` (6n, 6n) the
     constant mass matrix, ``kd`` (6n, 12n) [K | D] on the natural state order, ``k_eta0``
     (6n,).  Buffers are allocated once; ``steps`` returns new arrays."""
 
-    def __init__(self, lib, props, const, kd, k_eta0):
+    def __init__(self, lib, gimbal_tol, props, const, kd, k_eta0):
         n = len(props)
         self._fn = lib.hf_rigid_steps
-        self.model = np.concatenate([[float(n)], np.ravel(props), np.ravel(const), np.ravel(kd), k_eta0])
+        self.model = np.concatenate([[float(n), gimbal_tol], np.ravel(props), np.ravel(const), np.ravel(kd), k_eta0])
         self.y, self.acc = np.empty(12 * n), np.empty(6 * n)
         self.load, self.rate = np.empty(6 * n), np.empty(6 * n)
         self.work = np.empty(36 * n * n + 30 * n + 7 * 12 * n)   # up to 7 stages (RK6)
