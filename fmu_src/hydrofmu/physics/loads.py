@@ -17,6 +17,7 @@ both modes, since an exported constant M cannot carry it.
 import numpy as np
 
 from .current_polar import CurrentPolar
+from .hydrostatics import Hydrostatics
 from .lumped import LumpedBody
 from .viscous_drag import ViscousDrag
 
@@ -34,8 +35,13 @@ def _lumped(name, d):
     return LumpedBody(name, d["offset"], d["am"], d["ae"], d["icoo"], d["cd"], d["added_mass"])
 
 
+def _hydrostatics(name, d):
+    return Hydrostatics(name, d["stiffness"], d["position0"], d["attitude0"])
+
+
 KERNELS = {
     "riflex_body": _lumped,
+    "bem_hydrostatics": _hydrostatics,
     "aqwa_viscous_drag": _viscous_drag,
     "deeplines_current_polar": _current_polar,
 }

@@ -1,0 +1,316 @@
+"""Readers for the wave data of BEM results: excitation transfer functions and hydrostatics.
+
+Both return SI values in hydrofmu's convention (README / user guide, Waves): excitation per
+unit wave amplitude X(ω, β) with F(t) = Re{X·e^{+iωt}} for the elevation η = cos(ωt) at the
+global origin, direction β [deg] where the waves go to, counter-clockwise from +x.
+
+Capytaine (NetCDF, ``cpt.export_dataset``; needs the `bem` extra): ``excitation_force`` or
+``diffraction_force`` + ``Froude_Krylov_force`` over (omega, wave_direction [rad],
+influenced_dof), complex values split along a ``complex`` dimension (re, im).  Capytaine's
+time factor is e^{−iωt} with the incident elevation Re{e^{ik(x cos β + y sin β)}·e^{−iωt}}
+= cos(ωt − k·x) (the same wave as ours), so a force Re{F·e^{−iωt}} = Re{F̄·e^{+iωt}}:
+X = conj(F).  ω = ∞ and ω = 0 rows (no diffraction there) are dropped.  Hydrostatics:
+``hydrostatic_stiffness`` (influenced_dof, radiating_dof), about each body's
+``rotation_center``; Capytaine computes its rigid-body terms with the body's mass and
+``center_of_mass`` (the weight's moment −m·g·z_G in roll and pitch is in the matrix), and
+``inertia_matrix`` holds the mass used.
+
+WAMIT (manual, chapter 4): ``.3`` (diffraction) and ``.2`` (Haskind) lines
+``PER BETA I |X̄| phase(X̄)° Re(X̄) Im(X̄)``; PER [s] the period, BETA [deg] the heading
+(propagation direction, counter-clockwise from +x), I = 6·(body − 1) + k.  Time factor
+e^{+iωt}, phase relative to the incident elevation at the global origin: X = X̄·ρ·g·L^m
+(m = 2 for forces, 3 for moments), no conjugation.  ``.hst`` lines ``I J C̄``:
+C = C̄·ρ·g·L^k, k = 2 + [I is a rotation] + [J is a rotation]; WAMIT's C(4,4), C(5,5),
+C(4,6), C(5,6) hold the weight terms (−m·g·z_G, m·g·x_G, …) of the run's mass
+properties (the .hst has no mass of its own to check against the scene).
+"""
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .bem import DOF_NAMES, _single_name
+
+
+@dataclass
+class ExcitationData:
+    """Excitation transfer functions of a BEM result (module docstring's convention).
+
+    omega (nω,) [rad/s] increasing; directions (nβ,) [deg]; values (nω, nβ, n) complex
+    [N/m, N·m/m]; dofs [(body, k)]; bodies [names]; rotation_centers {body: [x, y, z]} when
+    the file has them; rho, g, water_depth (None when the file does not say)."""
+    path: str
+    kind: str
+    omega: np.ndarray
+    directions: np.ndarray
+    values: np.ndarray
+    dofs: list
+    bodies: list
+    rotation_centers: dict = field(default_factory=dict)
+    rho: float = None
+    g: float = None
+    water_depth: float = None
+
+    def body(self, name):
+        """(nω, nβ, 6) complex of one body, zero for dofs the file leaves out."""
+        out = np.zeros(self.values.shape[:2] + (6,), complex)
+        for c, (b, k) in enumerate(self.dofs):
+            if b == name:
+                out[:, :, k - 1] = self.values[:, :, c]
+        return out
+
+
+@dataclass
+class HydrostaticsData:
+    """Hydrostatic restoring of a BEM result: ``stiffness`` {body: 6×6} [N/m, N, N·m/rad]
+    about each body's rotation centre; ``mass`` {body: kg} and ``center_of_mass``
+    {body: [x, y, z]} the file used (when it says); ``weight``: True when the matrix holds
+    the weight's moment terms."""
+    path: str
+    kind: str
+    stiffness: dict
+    bodies: list
+    weight: bool
+    mass: dict = field(default_factory=dict)
+    center_of_mass: dict = field(default_factory=dict)
+    rotation_centers: dict = field(default_factory=dict)
+    rho: float = None
+    g: float = None
+
+
+def _open(path):
+    """A Capytaine dataset as xarray, or one InputError."""
+    try:
+        import xarray as xr
+    except ImportError:
+        raise InputError(path, None, "bem", "reading Capytaine datasets needs xarray and netCDF4: "
+                                             "pip install -e \".[bem]\"") from None
+    try:
+        return xr.load_dataset(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(path, None, "bem", f"cannot read as a NetCDF dataset ({exc})") from None
+
+
+def _scalar(ds, name):
+    if name not in ds.coords and name not in ds:
+        return None
+    v = np.atleast_1d(ds[name].values).astype(float)
+    return float(v[0]) if v.size == 1 else None
+
+
+def _dof(path, name, ds, where):
+    body, _, dof = str(name).rpartition("__")
+    if dof not in DOF_NAMES:
+        raise InputError(path, None, where, f"{name!r} is not a rigid-body dof ({', '.join(DOF_NAMES)}, "
+                                            f"or <body>__<dof>)")
+    return body or _single_name(ds), DOF_NAMES.index(dof) + 1
+
+
+def _complex(var):
+    if "complex" in var.dims:
+        return var.sel(complex="re").values + 1j * var.sel(complex="im").values
+    return np.asarray(var.values)
+
+
+def _centres(ds, bodies):
+    if "rotation_center" not in ds.coords and "rotation_center" not in ds:
+        return {}
+    rc = ds["rotation_center"]
+    if "body" in rc.dims:
+        return {str(n): rc.sel(body=n).values.astype(float).tolist() for n in rc["body"].values}
+    return {bodies[0]: rc.values.astype(float).tolist()}
+
+
+def read_excitation(path, ulen=None, rho=None, g=None) -> ExcitationData:
+    """Excitation of a Capytaine dataset (.nc) or a WAMIT .3 / .2 file (``ulen`` [m], ``rho``,
+    ``g`` make WAMIT's values dimensional)."""
+    path = Path(path)
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        return _capytaine_excitation(path)
+    if path.suffix in (".2", ".3"):
+        return _wamit_excitation(path, ulen, rho, g)
+    raise InputError(path, None, "bem", "expected a Capytaine dataset (.nc) or a WAMIT .3 (diffraction) / "
+                                        ".2 (Haskind) file for the wave excitation")
+
+
+def _capytaine_excitation(path):
+    ds = _open(path)
+    if "excitation_force" in ds:
+        name, x = "excitation_force", _complex(ds["excitation_force"])
+        var = ds["excitation_force"]
+    elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
+        name, var = "diffraction_force", ds["diffraction_force"]
+        x = _complex(var) + _complex(ds["Froude_Krylov_force"].transpose(*var.dims))
+    else:
+        raise InputError(path, None, "excitation_force", "missing: the dataset has no excitation_force nor "
+                                                         "diffraction_force + Froude_Krylov_force (solve the "
+                                                         "diffraction problems: a wave_direction coordinate)")
+    dims = [d for d in var.dims if d != "complex"]
+    want = ("omega", "wave_direction", "influenced_dof")
+    if sorted(dims) != sorted(want):
+        raise InputError(path, None, name, f"expected dimensions {want}, found {tuple(dims)} (select one "
+                                           f"value of every other dimension before exporting)")
+    x = np.moveaxis(x, [dims.index(d) for d in want], [0, 1, 2])
+    omega = ds["omega"].values.astype(float)
+    keep = np.isfinite(omega) & (omega > 0)
+    omega, x = omega[keep], x[keep]
+    order = np.argsort(omega)
+    omega, x = omega[order], x[order]
+    if omega.size < 2 or np.any(np.diff(omega) <= 0):
+        raise InputError(path, None, "omega", "at least two distinct finite frequencies needed for the excitation")
+    beta = np.degrees(np.atleast_1d(ds["wave_direction"].values.astype(float)))
+    names = [str(n) for n in np.atleast_1d(ds["influenced_dof"].values)]
+    dofs = [_dof(path, n, ds, "influenced_dof") for n in names]
+    bad = ~np.isfinite(x)
+    if bad.any():
+        i, j, k = np.argwhere(bad)[0]
+        raise InputError(path, None, name, f"{bad.sum()} non-finite value(s) in the transfer function, first at "
+                                           f"omega={omega[i]:g} rad/s, wave_direction={beta[j]:g}°, "
+                                           f"influenced_dof={names[k]}")
+    bodies = list(dict.fromkeys(b for b, _ in dofs))
+    return ExcitationData(str(path), "Capytaine", omega, beta, np.conj(x), dofs, bodies, _centres(ds, bodies),
+                          _scalar(ds, "rho"), _scalar(ds, "g"), _scalar(ds, "water_depth"))
+
+
+def _numbers(path, names, minimum):
+    """[(line number, [floats])] of a WAMIT numeric file (one error naming line and field)."""
+    try:
+        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+    except OSError as exc:
+        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
+    rows = []
+    for number, line in enumerate(text, 1):
+        words = line.replace(",", " ").split()
+        if not words:
+            continue
+        if len(words) < minimum:
+            raise InputError(path, number, " ".join(names), f"expected {len(names)} numbers, found {len(words)}: "
+                                                            f"{line.strip()!r}")
+        vals = []
+        for name, w in zip(names, words):
+            try:
+                v = float(w.replace("D", "E").replace("d", "e"))
+            except ValueError:
+                raise InputError(path, number, name, f"not a number: {w!r}") from None
+            if not np.isfinite(v):
+                raise InputError(path, number, name, f"non-finite value {w!r}")
+            vals.append(v)
+        rows.append((number, vals))
+    return rows
+
+
+def _wamit_scale(path, ulen, rho, g):
+    for name, v in (("ulen", ulen), ("rho", rho), ("g", g)):
+        if v is None or not v > 0:
+            raise InputError(path, None, name, f"a WAMIT file is nondimensional: declare {name} (> 0)")
+
+
+def _index(path, number, value, name="I"):
+    if value != int(value) or value < 1:
+        raise InputError(path, number, name, f"dof index must be a positive integer, found {value:g}")
+    return int(value)
+
+
+def _wamit_excitation(path, ulen, rho, g):
+    _wamit_scale(path, ulen, rho, g)
+    rows = _numbers(path, ["PER", "BETA", "I", "MOD", "PHA", "RE", "IM"], 7)
+    table, first = {}, {}
+    for number, (per, beta, i, _, _, re, im) in rows:
+        if per in (0.0, -1.0):
+            continue                      # the zero / infinite period limits: no excitation wave
+        if per < 0:
+            raise InputError(path, number, "PER", f"period must be > 0, found {per:g}")
+        i = _index(path, number, i)
+        key = (per, beta, i)
+        if key in first:
+            raise InputError(path, number, "PER BETA I", f"duplicate ({per:g}, {beta:g}, {i}) (first at line "
+                                                         f"{first[key]})")
+        first[key] = number
+        table[key] = complex(re, im) * rho * g * ulen ** (2 if (i - 1) % 6 < 3 else 3)
+    periods = sorted({k[0] for k in table}, reverse=True)
+    betas = sorted({k[1] for k in table})
+    index = sorted({k[2] for k in table})
+    if len(periods) < 2:
+        raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 2 needed")
+    x = np.zeros((len(periods), len(betas), len(index)), complex)
+    for (per, beta, i), v in table.items():
+        x[periods.index(per), betas.index(beta), index.index(i)] = v
+    dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in index]
+    bodies = list(dict.fromkeys(b for b, _ in dofs))
+    return ExcitationData(str(path), "WAMIT", 2 * np.pi / np.array(periods), np.array(betas, float), x, dofs,
+                          bodies)
+
+
+def read_hydrostatics(path, ulen=None, rho=None, g=None) -> HydrostaticsData:
+    """Hydrostatic restoring of a Capytaine dataset (.nc) or a WAMIT .hst file."""
+    path = Path(path)
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        return _capytaine_hydrostatics(path)
+    if path.suffix == ".hst":
+        return _wamit_hydrostatics(path, ulen, rho, g)
+    raise InputError(path, None, "bem", "expected a Capytaine dataset (.nc) or a WAMIT .hst file for the "
+                                        "hydrostatic restoring")
+
+
+def _capytaine_hydrostatics(path):
+    ds = _open(path)
+    if "hydrostatic_stiffness" not in ds:
+        raise InputError(path, None, "hydrostatic_stiffness", "missing: export the dataset with hydrostatics "
+                                                              "(fill_dataset(..., hydrostatics=True))")
+    var = ds["hydrostatic_stiffness"]
+    extra = [d for d in var.dims if d not in ("influenced_dof", "radiating_dof")]
+    if extra:
+        var = var.squeeze(extra, drop=True) if all(ds.sizes[d] == 1 for d in extra) else None
+    if var is None:
+        raise InputError(path, None, "hydrostatic_stiffness", "several values of rho or g: select one")
+    rows = [_dof(path, n, ds, "influenced_dof") for n in var["influenced_dof"].values]
+    cols = [_dof(path, n, ds, "radiating_dof") for n in var["radiating_dof"].values]
+    c = var.values.astype(float)
+    if not np.all(np.isfinite(c)):
+        raise InputError(path, None, "hydrostatic_stiffness", "non-finite value(s)")
+    bodies = list(dict.fromkeys(b for b, _ in rows))
+    stiffness = {}
+    for b in bodies:
+        m = np.zeros((6, 6))
+        for r, (br, i) in enumerate(rows):
+            for q, (bc, j) in enumerate(cols):
+                if br == b and bc == b:
+                    m[i - 1, j - 1] = c[r, q]
+        stiffness[b] = m
+    mass = {}
+    if "inertia_matrix" in ds:
+        im = ds["inertia_matrix"]
+        im = im.squeeze([d for d in im.dims if d not in ("influenced_dof", "radiating_dof")], drop=True)
+        names = [str(n) for n in im["influenced_dof"].values]
+        for b in bodies:
+            surge = next((names.index(n) for n in names if _dof(path, n, ds, "influenced_dof") == (b, 1)), None)
+            if surge is not None:
+                mass[b] = float(im.values[surge, surge])
+    com = {}
+    if "center_of_mass" in ds.coords or "center_of_mass" in ds:
+        v = ds["center_of_mass"]
+        com = ({str(n): v.sel(body=n).values.astype(float).tolist() for n in v["body"].values}
+               if "body" in v.dims else {bodies[0]: v.values.astype(float).tolist()})
+    return HydrostaticsData(str(path), "Capytaine", stiffness, bodies, weight=bool(com), mass=mass,
+                            center_of_mass=com, rotation_centers=_centres(ds, bodies),
+                            rho=_scalar(ds, "rho"), g=_scalar(ds, "g"))
+
+
+def _wamit_hydrostatics(path, ulen, rho, g):
+    _wamit_scale(path, ulen, rho, g)
+    rows = _numbers(path, ["I", "J", "C"], 3)
+    stiffness = {}
+    for number, (i, j, c) in rows:
+        i, j = _index(path, number, i), _index(path, number, j, "J")
+        bi, bj = (i - 1) // 6 + 1, (j - 1) // 6 + 1
+        if bi != bj:
+            if c != 0:
+                raise InputError(path, number, "C", f"hydrostatic coupling between bodies {bi} and {bj}: not supported")
+            continue
+        ki, kj = (i - 1) % 6, (j - 1) % 6
+        m = stiffness.setdefault(f"body{bi}", np.zeros((6, 6)))
+        m[ki, kj] = c * rho * g * ulen ** (2 + (ki >= 3) + (kj >= 3))
+    if not stiffness:
+        raise InputError(path, None, "I J C", "no hydrostatic coefficients in the file")
+    return HydrostaticsData(str(path), "WAMIT", stiffness, sorted(stiffness), weight=True)
