@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from conftest import MODELS
+from hydrofmu.bench import native as native_timing
 from hydrofmu.bench.robust import ARENA_KB, FLAT_KB, growth
 
 pytest.importorskip("libcosimpy")
@@ -54,7 +55,7 @@ def hosts(tmp_path_factory):
     d = tmp_path_factory.mktemp("hosts")
     return {
         "cosim": compile_c("cosim_run.c", d / "cosim_run", f"-L{lib}", "-lcosimc", f"-Wl,-rpath,{lib}"),
-        "fmi": compile_c("fmi_host.c", d / "fmi_host", "-ldl", "-lpthread"),
+        "fmi": compile_c("fmi_host.c", d / "fmi_host", f"-I{Path(native_timing.SOURCE).parent}", "-ldl", "-lpthread"),
     }
 
 
@@ -431,3 +432,58 @@ def test_exception_with_no_category_reaches_the_host_as_text(hosts, load_fmu, tm
     logs = [line for line in run.stdout.splitlines() if line.startswith("LOG")]
     assert logs and not any("NULL-CATEGORY" in line or "NULL-MESSAGE" in line for line in logs), logs
     assert "JSONDecodeError" in run.stdout  # the message's second line
+
+
+# -- Python thread states and BLAS threads in a native host ---------------------------------
+
+def probed(run):
+    """{instance: [the Python thread state its thread held after each step]} and the
+    process's thread count once the instances ended, from an FMI_HOST_PROBE run."""
+    states, threads = {}, None
+    for p in (line.split() for line in run.stdout.splitlines()):
+        if p[:1] == ["tstate"]:
+            states.setdefault(int(p[1]), []).append(int(p[3], 16) if p[3] != "(nil)" else 0)
+        elif p[:1] == ["threads"]:
+            threads = int(p[1])
+    return states, threads
+
+
+def test_host_threads_keep_one_python_thread_state(hosts, load_fmu):
+    """Two host threads Python does not know, one instance each: between FMI calls each
+    thread still holds the same Python thread state (the shim keeps it: no call creates or
+    deletes one), and once they ended the process runs no BLAS threads (the host's main
+    thread and Python's own only: numpy's OpenBLAS starts one per core unless told, and the
+    host's environment does not tell it); the outputs equal fmpy's here bit for bit."""
+    vr = load_fmu[3]
+    inputs = {vr["position[1]"]: 2.0, vr["velocity[1]"]: 0.3, vr["velocity[6]"]: 0.01}
+    outputs = [vr[f"force[{i}]"] for i in (1, 2, 6)]
+    env = {k: v for k, v in clean_env(FMI_HOST_PROBE="1").items()
+           if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+    run, got = run_fmi_host(hosts, load_fmu, 2, 20, 0.1, inputs, outputs, env=env)
+    assert run.returncode == 0 and "host exits normally" in run.stdout, run.stdout + run.stderr
+    states, threads = probed(run)
+    assert sorted(states) == [0, 1] and all(len(s) == 20 for s in states.values())
+    assert all(s[0] != 0 and set(s) == {s[0]} for s in states.values()), states
+    assert states[0][0] != states[1][0]
+    assert threads == 2
+    for k in (0, 1):
+        ref = fmpy_reference(load_fmu, 20, 0.1, {v: x * (k + 1) for v, x in inputs.items()}, outputs)
+        assert {(n, o): got[k, n, o] for n, o in ref} == ref
+
+
+def test_every_call_from_a_thread_of_its_own(hosts, scenes, tmp_path):
+    """A host that makes each step of an instance in a new thread, ended after the step, and
+    frees the instance from yet another: every thread's Python state is deleted as the
+    thread ends (while Python runs on), nothing crashes, and both instances of the dynamics
+    FMU step as fmpy steps them, bit for bit."""
+    dyn = unzip(scenes["moored_barge"] / "moored_barge_barge_dynamics.fmu", tmp_path)
+    vr = dyn[3]
+    inputs = {vr["force[1]"]: 1e3, vr["force[3]"]: -5e2, vr["force[5]"]: 2e3}
+    outputs = [vr[f"position[{i}]"] for i in range(1, 4)]
+    run, got = run_fmi_host(hosts, dyn, 2, 30, 0.1, inputs, outputs, env=clean_env(FMI_HOST_HOP="1"))
+    assert run.returncode == 0 and "host exits normally" in run.stdout, run.stdout[-2000:] + run.stderr
+    assert "LOG" not in run.stdout and "failed" not in run.stdout
+    for k in (0, 1):
+        ref = fmpy_reference(dyn, 30, 0.1, {v: x * (k + 1) for v, x in inputs.items()}, outputs)
+        assert {(n, o): got[k, n, o] for n, o in ref} == ref
+    assert got[1, 30, outputs[0]] != 0.0

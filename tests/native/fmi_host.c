@@ -16,7 +16,14 @@
  * time initialised and stepped once with the inputs times 7 (values the run never sets),
  * then freed, and prints "rss CYCLE KB" (resident memory) every EVERY cycles; the run
  * follows, so its instance 0 comes after N instances of the same name.
+ *
+ * FMI_HOST_PROBE=1: after each step, "tstate k step P" with P the Python thread state the
+ * calling thread holds between FMI calls (PyGILState_GetThisThreadState, 0 for none), and
+ * once every instance has ended, "threads N": the threads the process still runs.
+ * FMI_HOST_HOP=1: every step of an instance (its SetReal, DoStep, GetReal) in a thread of its
+ * own, started for that step and ended after it, and Terminate + FreeInstance in another.
  */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
 #include <dlfcn.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -25,24 +32,7 @@
 #include <string.h>
 #include <unistd.h>
 
-typedef void *C;
-typedef struct {
-    void (*logger)(void *, const char *, int, const char *, const char *, ...);
-    void *(*allocateMemory)(size_t, size_t);
-    void (*freeMemory)(void *);
-    void (*stepFinished)(void *, int);
-    void *componentEnvironment;
-} Callbacks;
-
-typedef struct {
-    C (*Instantiate)(const char *, int, const char *, const char *, const Callbacks *, int, int);
-    int (*SetupExperiment)(C, int, double, double, int, double);
-    int (*EnterInitializationMode)(C), (*ExitInitializationMode)(C), (*Terminate)(C);
-    void (*FreeInstance)(C);
-    int (*SetReal)(C, const unsigned *, size_t, const double *);
-    int (*GetReal)(C, const unsigned *, size_t, double *);
-    int (*DoStep)(C, double, double, int);
-} Fmi;
+#include "fmi2_host.h" /* hydrofmu/bench: the FMI calls and the loader */
 
 static Fmi fmis[16];
 static const char *dirs[16], *id, *guid;
@@ -98,6 +88,59 @@ static void cycles(long n, long every) {
     }
 }
 
+static int probe, hop;
+
+static int thread_count(void) {
+    int n = 0;
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "Threads: %d", &n) == 1) break;
+    if (f) fclose(f);
+    return n;
+}
+
+typedef struct {
+    Fmi fmi;
+    C c;
+    long k;
+    int n, bad;
+    double *in, *out;
+} Step;
+
+/* One step of instance k: set, step, get, print (and probe). */
+static void *step(void *arg) {
+    Step *s = arg;
+    const Fmi fmi = s->fmi;
+    s->bad = fmi.SetReal(s->c, in_vr, nin, s->in) || fmi.DoStep(s->c, s->n * dt, dt, 1) ||
+             fmi.GetReal(s->c, out_vr, nout, s->out);
+    pthread_mutex_lock(&print_lock);
+    for (int i = 0; i < nout && !s->bad; i++) printf("%ld %d %u %.17g\n", s->k, s->n + 1, out_vr[i], s->out[i]);
+    if (probe) {
+        void *(*state)(void);
+        *(void **)&state = dlsym(RTLD_DEFAULT, "PyGILState_GetThisThreadState");
+        printf("tstate %ld %d %p\n", s->k, s->n + 1, state ? state() : NULL);
+    }
+    pthread_mutex_unlock(&print_lock);
+    return NULL;
+}
+
+static void *finish(void *arg) {
+    Step *s = arg;
+    s->fmi.Terminate(s->c);
+    s->fmi.FreeInstance(s->c);
+    return NULL;
+}
+
+/* f(arg) in this thread, or with FMI_HOST_HOP in a new thread, waited for. */
+static void call(void *(*f)(void *), void *arg) {
+    pthread_t t;
+    if (hop && pthread_create(&t, NULL, f, arg) == 0)
+        pthread_join(t, NULL);
+    else
+        f(arg);
+}
+
 static void *run(void *arg) {
     long k = (long)arg;
     const Fmi fmi = fmis[k % ndirs];
@@ -114,15 +157,10 @@ static void *run(void *arg) {
               fmi.ExitInitializationMode(c);
     double in[64], out[64];
     for (int i = 0; i < nin; i++) in[i] = in_val[i] * (double)(k + 1);
-    for (int n = 0; n < steps && !bad; n++) {
-        bad = fmi.SetReal(c, in_vr, nin, in) || fmi.DoStep(c, n * dt, dt, 1) || fmi.GetReal(c, out_vr, nout, out);
-        pthread_mutex_lock(&print_lock);
-        for (int i = 0; i < nout && !bad; i++) printf("%ld %d %u %.17g\n", k, n + 1, out_vr[i], out[i]);
-        pthread_mutex_unlock(&print_lock);
-    }
-    if (bad) printf("instance %ld: an FMI call failed\n", k);
-    fmi.Terminate(c);
-    fmi.FreeInstance(c);
+    Step s = {fmi, c, k, 0, bad, in, out};
+    for (; s.n < steps && !s.bad; s.n++) call(step, &s);
+    if (s.bad) printf("instance %ld: an FMI call failed\n", k);
+    call(finish, &s);
     return NULL;
 }
 
@@ -139,30 +177,18 @@ int main(int argc, char **argv) {
         sscanf(p, "%u:%lf", &in_vr[nin], &in_val[nin]);
     for (char *p = strtok(argv[8], ","); p && nout < 64; p = strtok(NULL, ","), nout++)
         sscanf(p, "%u", &out_vr[nout]);
-    const char *names[] = {"fmi2Instantiate", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
-                           "fmi2ExitInitializationMode", "fmi2Terminate", "fmi2FreeInstance",
-                           "fmi2SetReal", "fmi2GetReal", "fmi2DoStep"};
     void *handles[16];
-    for (int d = 0; d < ndirs; d++) {
-        char lib[4200];
-        snprintf(lib, sizeof lib, "%s/binaries/linux64/%s.so", dirs[d], id);
-        if (!(handles[d] = dlopen(lib, RTLD_NOW | RTLD_LOCAL))) {
-            printf("dlopen failed: %s\n", dlerror());
-            return 1;
-        }
-        void **slots = (void **)&fmis[d]; /* members are pointers in the order of names */
-        for (size_t i = 0; i < sizeof names / sizeof *names; i++)
-            if (!(slots[i] = dlsym(handles[d], names[i]))) {
-                printf("missing %s\n", names[i]);
-                return 1;
-            }
-    }
+    for (int d = 0; d < ndirs; d++)
+        if (!(handles[d] = fmi_load(dirs[d], id, &fmis[d]))) return 1;
+    probe = getenv("FMI_HOST_PROBE") != NULL;
+    hop = getenv("FMI_HOST_HOP") != NULL;
     const char *cyc = getenv("FMI_HOST_CYCLES");
     long n = 0, every = 0;
     if (cyc && sscanf(cyc, "%ld:%ld", &n, &every) >= 1) cycles(n, every);
     pthread_t t[16];
     for (long k = 0; k < threads && k < 16; k++) pthread_create(&t[k], NULL, run, (void *)k);
     for (long k = 0; k < threads && k < 16; k++) pthread_join(t[k], NULL);
+    if (probe) printf("threads %d\n", thread_count());
     for (int d = 0; d < ndirs; d++) dlclose(handles[d]);
     printf("host exits normally\n");
     return 0;

@@ -8,6 +8,8 @@ Parts (each also callable alone, see ``PARTS``):
 - growth: cost against kernel length and simulated time
 - floor: startup and cost per step of every scene of models/ and of 2, 4, 8 coupled bodies,
   as multiples of the pythonfmu floor (``floor``), with the targets and a noise verdict
+- native: FMUs stepped alone in a native C host against the same FMUs under fmpy: cost per
+  step and startup, native/fmpy side by side (``native``)
 - stability: added-mass stability map, explicit against export (``stability``)
 - bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 - robust: time to report one bad number near the end of a 50 MB deck against reading it
@@ -32,7 +34,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from . import cosim_cost, floor, memory_cost, overhead, radiation_cost, robust, stability  # noqa: E402
+from . import cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust, stability  # noqa: E402
 
 
 def write_csv(path, rows):
@@ -309,6 +311,29 @@ def part_floor(out, quick):
     return lines
 
 
+def part_native(out, quick):
+    """The pythonfmu floor and the FMUs of moored_barge and side_by_side, each alone in a native
+    C host against fmpy (target: native ≤ 1.0× fmpy per step)."""
+    from ..fmi.build import build_scene
+    from ..scene import load_scene
+    from ..fmi.shim import install_shim
+    # the floor with hydrofmu's shim, which starts Python in a host that has none
+    fmus = {"pythonfmu_floor": install_shim(floor.build_floor(out / "native"))}
+    for name in ("moored_barge", "side_by_side"):
+        folder = build_scene(load_scene(Path("models") / f"{name}.toml"), out / "native" / "scenes", log=lambda *_: None)
+        fmus.update({f.stem: f for f in sorted(folder.glob("*.fmu"))})
+    rows = native.compare(fmus, rounds=3 if quick else 5, steps=500 if quick else 10_000, work=out / "native")
+    write_csv(out / "native.csv", rows)
+    lines = []
+    for r in rows:
+        step = (f"too noisy per step (spread {100 * r['step_spread']:.0f} %)" if r["step_noisy"] else
+                f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
+                f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
+        lines.append(f"{r['label']}: {step}; startup {1e3 * r['startup_s']:.0f} ms native (Python started by "
+                     f"the FMU) vs {1e3 * r['startup_fmpy_s']:.0f} ms under fmpy (Python running)")
+    return lines
+
+
 def part_stability(out, quick):
     csv_path, png = stability.run(out)
     return [f"added-mass map: {csv_path.name}, {png.name}"]
@@ -364,7 +389,7 @@ def part_batch(out, quick):
 
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
-         "floor": part_floor, "stability": part_stability, "bem": part_bem,
+         "floor": part_floor, "native": part_native, "stability": part_stability, "bem": part_bem,
          "robust": part_robust, "batch": part_batch, "ecco": part_ecco}
 
 

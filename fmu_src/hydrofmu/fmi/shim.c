@@ -33,7 +33,8 @@
  * numpy imports, and releases the GIL.  The interpreter then lives until the process
  * ends: numpy cannot be imported again after Py_Finalize.  pythonfmu then finds Python
  * initialised and leaves it alone.  Every forwarded call holds the GIL (pythonfmu
- * takes it too; PyGILState calls nest), so hosts may call from any thread.
+ * takes it too; PyGILState calls nest), so hosts may call from any thread; each host thread
+ * gets one Python thread state at its first call, kept until it ends (keep_thread_state).
  * A failure is kept and reported by fmi2Instantiate as one log message.
  *
  * Instance pool: pythonfmu 0.7's fmi2Instantiate leaks ~1.2 kB of Python objects every
@@ -171,8 +172,12 @@ static int no_pool;  /* HYDROFMU_POOL=0: free every instance at fmi2FreeInstance
 /* The GIL functions of the process's Python (PyGILState_STATE is an int-sized enum). */
 static int (*gil_ensure)(void);
 static void (*gil_release)(int);
+static void keep_thread_state(void);
+static __thread int kept; /* this thread has a Python thread state that outlives each call */
 
-#define GIL_TAKE int gil_ = gil_ensure ? gil_ensure() : 0
+#define GIL_TAKE                                  \
+    if (gil_ensure && !kept) keep_thread_state(); \
+    int gil_ = gil_ensure ? gil_ensure() : 0
 #define GIL_GIVE if (gil_ensure) gil_release(gil_)
 
 /* Path of the inner library: this file's path with ".so" replaced by "_pythonfmu.so". */
@@ -200,9 +205,16 @@ static int inner_path(char *out, size_t size) {
 #define HOWTO "Set HYDROFMU_PYTHON to a Python >= " MINIMUM_PYTHON " interpreter (or venv python) " \
     "that has numpy (and scipy for convolution memory) and a shared libpython (python3 -m sysconfig | grep INSTSONAME), or rebuild the FMU with one."
 
-/* Run in the new interpreter: sys._hydrofmu_check = '' when usable, else why not. */
+/*
+ * Run in the new interpreter: sys._hydrofmu_check = '' when usable, else why not.  numpy
+ * loads here, before any slave: one BLAS thread per process unless the host's environment
+ * says otherwise (a host's parallelism is across FMUs; the slaves' products are 6x6-sized),
+ * set for the scipy loaded later too (its own BLAS reads the same variables).
+ */
 static const char CHECK[] =
-    "import sys\n"
+    "import os, sys\n"
+    "for _n in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS'):\n"
+    "    os.environ.setdefault(_n, '1')\n"
     "def _c():\n"
     "    v = '%d.%d.%d' % sys.version_info[:3]\n"
     "    if sys.version_info < (" MINIMUM_PYTHON_TUPLE "):\n"
@@ -214,7 +226,7 @@ static const char CHECK[] =
     "            v, sys.executable, sys.prefix, type(e).__name__, e)\n"
     "    return ''\n"
     "sys._hydrofmu_check = _c()\n"
-    "del _c\n";
+    "del _c, _n\n";
 
 /*
  * What $HYDROFMU_PYTHON is asked: its libpython (the first candidate file that exists,
@@ -448,6 +460,71 @@ static void find_python_api(void) {
         }
 }
 
+/*
+ * One Python thread state per host thread, for good.  PyGILState_Ensure on a thread Python
+ * does not know creates a thread state and the matching PyGILState_Release deletes it again,
+ * with the frame stack it allocated (an mmap/munmap pair and fresh pages): in a native host
+ * every FMI call paid that, and more than the call itself for a cheap one.  So the first call
+ * from such a thread creates a state and keeps it (PyGILState_Ensure, then PyEval_SaveThread:
+ * the GIL is released, the state stays the thread's, its counter at 1 so that no later
+ * Release deletes it); every call after only takes and gives the GIL.  Threads Python knows
+ * (a Python host's) and threads whose state another FMU's shim keeps are left as they are.
+ * When the thread ends, a thread-specific destructor deletes the state, unless Python is
+ * gone or going.  The key is made on first use only (a process has ~1024, and fmpy loads a
+ * new copy of the library for every instance) and deleted when the library unloads: the
+ * states it kept then stay with their threads (later FMUs use them) until the process ends.
+ */
+static struct {
+    void *(*ThisThreadState)(void);
+    void *(*SaveThread)(void);
+    void (*RestoreThread)(void *);
+    void (*Clear)(void *);
+    void (*DeleteCurrent)(void);
+    int (*IsInitialized)(void);
+    int (*IsFinalizing)(void);
+} ts_api;
+static pthread_key_t ts_key;
+static int ts_key_ok;
+static pthread_once_t ts_key_once = PTHREAD_ONCE_INIT;
+
+/* At thread exit the C library has already cleared Python's own thread-specific pointer to
+   the state (so no PyGILState_Release): the state is made current, cleared and deleted. */
+static void drop_thread_state(void *state) {
+    if (!state || !ts_api.DeleteCurrent || !ts_api.IsInitialized() ||
+        (ts_api.IsFinalizing && ts_api.IsFinalizing()))
+        return;
+    ts_api.RestoreThread(state);
+    ts_api.Clear(state);
+    ts_api.DeleteCurrent(); /* and releases the GIL */
+}
+
+static void find_thread_state_api(void) {
+    *(void **)&ts_api.ThisThreadState = dlsym(RTLD_DEFAULT, "PyGILState_GetThisThreadState");
+    *(void **)&ts_api.SaveThread = dlsym(RTLD_DEFAULT, "PyEval_SaveThread");
+    *(void **)&ts_api.RestoreThread = dlsym(RTLD_DEFAULT, "PyEval_RestoreThread");
+    *(void **)&ts_api.Clear = dlsym(RTLD_DEFAULT, "PyThreadState_Clear");
+    *(void **)&ts_api.DeleteCurrent = dlsym(RTLD_DEFAULT, "PyThreadState_DeleteCurrent");
+    if (!ts_api.Clear) ts_api.DeleteCurrent = NULL; /* then a state is kept until the process ends */
+    *(void **)&ts_api.IsInitialized = dlsym(RTLD_DEFAULT, "Py_IsInitialized");
+    *(void **)&ts_api.IsFinalizing = dlsym(RTLD_DEFAULT, "Py_IsFinalizing"); /* 3.13 on */
+    if (!ts_api.IsFinalizing) *(void **)&ts_api.IsFinalizing = dlsym(RTLD_DEFAULT, "_Py_IsFinalizing");
+    if (!ts_api.ThisThreadState || !ts_api.SaveThread || !ts_api.RestoreThread || !ts_api.IsInitialized)
+        memset(&ts_api, 0, sizeof ts_api);
+}
+
+static void make_ts_key(void) {
+    ts_key_ok = pthread_key_create(&ts_key, drop_thread_state) == 0;
+}
+
+static void keep_thread_state(void) {
+    kept = 1;
+    if (!ts_api.ThisThreadState || ts_api.ThisThreadState()) return;
+    pthread_once(&ts_key_once, make_ts_key);
+    gil_ensure();
+    void *state = ts_api.SaveThread();
+    if (ts_key_ok) pthread_setspecific(ts_key, state); /* else kept until the process ends */
+}
+
 static void load_inner(void) {
     char path[4096];
     if (!inner_path(path, sizeof path)) return;
@@ -460,6 +537,7 @@ static void load_inner(void) {
     *(void **)&gil_ensure = dlsym(RTLD_DEFAULT, "PyGILState_Ensure");
     *(void **)&gil_release = dlsym(RTLD_DEFAULT, "PyGILState_Release");
     if (!gil_release) gil_ensure = NULL;
+    find_thread_state_api();
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!h) {
         const char *e = dlerror();
@@ -493,6 +571,8 @@ static int ready(void) {
 
 /* Unload the inner library together with the shim, as the host would have unloaded it. */
 __attribute__((destructor)) static void unload_inner(void) {
+    if (ts_key_ok) pthread_key_delete(ts_key); /* drop_thread_state goes with the library */
+    ts_key_ok = 0;
     if (inner_handle) dlclose(inner_handle);
     inner_handle = NULL;
     inner_ok = 0;

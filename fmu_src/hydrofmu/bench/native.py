@@ -1,0 +1,110 @@
+"""FMUs in a native host against the same FMUs under fmpy.
+
+A native FMI host (a C program, ``native_host.c``, compiled here with the system compiler,
+no Python of its own: the FMU's shim starts the interpreter) and fmpy in a fresh Python
+process each do the same thing with one FMU: load and initialise it (the startup), then
+``steps`` times fmi2SetReal of every input + fmi2DoStep + fmi2GetReal of every output
+(the cost per step), then free it.  Each round runs fmpy, then the native host, back to
+back; the ratio native/fmpy of each round, its median over the rounds and its spread
+((max − min)/median, ``floor.NOISY`` and above: too noisy to trust) are reported.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from .floor import NOISY, spread
+
+SOURCE = Path(__file__).with_name("native_host.c")
+
+FMPY = '''import json, sys, time
+import numpy, fmpy
+from fmpy import read_model_description
+from fmpy.fmi2 import FMU2Slave
+folder, mid, guid, steps, dt, ins, outs = sys.argv[1:]
+steps, dt = int(steps), float(dt)
+ins = [tuple(map(float, p.split(":"))) for p in ins.split(",") if p]
+vin, xin = [int(v) for v, _ in ins], [x for _, x in ins]
+vout = [int(v) for v in outs.split(",") if v]
+t0 = time.perf_counter()
+s = FMU2Slave(guid=guid, unzipDirectory=folder, modelIdentifier=mid, instanceName="timed")
+s.instantiate()
+s.setupExperiment(startTime=0.0)
+s.enterInitializationMode()
+s.exitInitializationMode()
+t1 = time.perf_counter()
+for n in range(steps):
+    s.setReal(vin, xin)
+    s.doStep(n * dt, dt)
+    s.getReal(vout)
+t2 = time.perf_counter()
+s.terminate()
+s.freeInstance()
+print(json.dumps({"startup_s": t1 - t0, "step_s": (t2 - t1) / max(steps, 1), "free_s": time.perf_counter() - t2}))
+'''
+
+
+def host(folder) -> Path:
+    """native_host.c compiled into ``folder``."""
+    from ..cc import compiler
+    out = Path(folder) / "native_host"
+    subprocess.run(compiler() + ["-O2", f"-I{SOURCE.parent}", "-o", str(out), str(SOURCE), "-ldl"], check=True,
+                   capture_output=True)
+    return out
+
+
+def unpack(fmu, folder):
+    """Unzip ``fmu`` into ``folder``; returns (folder, model identifier, guid, inputs "vr:value,…",
+    outputs "vr,…"): every Real input at its start value (0 without one), every Real output."""
+    from fmpy import read_model_description
+    md = read_model_description(str(fmu))
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(folder)
+    ins = ",".join(f"{v.valueReference}:{float(v.start or 0.0)!r}" for v in md.modelVariables
+                   if v.causality == "input" and v.type == "Real")
+    outs = ",".join(str(v.valueReference) for v in md.modelVariables if v.causality == "output" and v.type == "Real")
+    return str(Path(folder).resolve()), md.coSimulation.modelIdentifier, md.guid, ins, outs
+
+
+def _json(cmd, env=None):
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
+    if out.returncode != 0:
+        raise RuntimeError(f"{cmd[0]} failed: {out.stdout[-2000:]}{out.stderr[-2000:]}")
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    if got.get("failed"):
+        raise RuntimeError(f"{cmd[0]}: an FMI call failed: {out.stderr[-2000:]}")
+    return got
+
+
+def compare(fmus, rounds=5, steps=10_000, dt=0.05, work=None):
+    """{label: FMU path} stepped alone in the native host and under fmpy, ``rounds`` rounds
+    back to back.  Rows {label, step_us, step_fmpy_us, step_x (native/fmpy), step_spread,
+    step_noisy, startup_s, startup_fmpy_s, startup_x, startup_spread, startup_noisy}: medians
+    over the rounds, each multiple the median of the rounds' ratios."""
+    with tempfile.TemporaryDirectory(dir=work) as tmp:
+        exe = host(tmp)
+        unpacked = {label: unpack(f, Path(tmp) / label) for label, f in fmus.items()}
+        got = {label: [] for label in fmus}
+        for _ in range(rounds):
+            for label, args in unpacked.items():
+                args = list(map(str, args[:3])) + [str(steps), repr(dt)] + list(args[3:])
+                py = _json([sys.executable, "-c", FMPY, *args])
+                c = _json([str(exe), *args])
+                got[label].append([py["step_s"], c["step_s"], py["startup_s"], c["startup_s"]])
+    rows = []
+    for label, t in got.items():
+        t = np.array(t)
+        step_x, start_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
+        rows.append({"label": label, "step_us": 1e6 * float(np.median(t[:, 1])),
+                     "step_fmpy_us": 1e6 * float(np.median(t[:, 0])), "step_x": float(np.median(step_x)),
+                     "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY,
+                     "startup_s": float(np.median(t[:, 3])), "startup_fmpy_s": float(np.median(t[:, 2])),
+                     "startup_x": float(np.median(start_x)), "startup_spread": spread(start_x),
+                     "startup_noisy": spread(start_x) > NOISY})
+    return rows
