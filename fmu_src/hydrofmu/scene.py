@@ -16,6 +16,7 @@ import numpy as np
 from . import admissible
 from .description import Effect, HydroCoupling, Kernel
 from .errors import InputError, InputWarning
+from .names import did_you_mean
 from .textfile import read_text
 
 ACCEL_MODES = ("export", "explicit")
@@ -61,6 +62,7 @@ class Problems:
 
     def __init__(self, path):
         self.path, self.items = Path(path), []
+        self.unknown = {}  # key path of an unknown key -> the keys allowed there (batch knobs are checked by it)
         self.decks = {}   # (deck path, reader, args) -> entries or the InputError: each deck read once
 
     def add(self, key, message):
@@ -77,7 +79,9 @@ class Problems:
     def raise_if_any(self):
         if self.items:
             (first, message), rest = self.items[0], self.items[1:]
-            raise InputError(self.path, None, first, "; ".join([message] + [f"{k}: {m}" for k, m in rest]))
+            exc = InputError(self.path, None, first, "; ".join([message] + [f"{k}: {m}" for k, m in rest]))
+            exc.unknown = dict(self.unknown)   # for callers that check key paths (batch knobs)
+            raise exc
 
     def deck(self, path, where, reader, *args):
         """``reader(path, *args)``, read once per scene; a deck error is recorded once
@@ -169,8 +173,9 @@ class Problems:
     def known_keys(self, table, where, allowed):
         for key in table:
             if key not in allowed:
-                self.add(f"{where}.{key}" if where else key,
-                         f"unknown key (allowed: {', '.join(sorted(allowed))})")
+                path = f"{where}.{key}" if where else key
+                self.unknown[path] = sorted(allowed)
+                self.add(path, f"unknown key{did_you_mean(key, allowed)} (allowed: {', '.join(sorted(allowed))})")
 
     def array(self, value, where):
         try:
