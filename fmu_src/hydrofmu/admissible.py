@@ -71,3 +71,25 @@ def negative_diagonal(matrix):
 
 def _list(values):
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
+
+
+STEPS_TOL = 1e-9   # relative: stop/step within this of a whole number counts as whole (0.3/0.1 = 2.9999999999999996)
+
+
+def whole_steps(stop, step):
+    """(number of communication steps, problems) of a fixed-step run from 0 to ``stop`` [s] in
+    steps of ``step`` [s]: ``stop`` must be a whole number n ≥ 1 of steps (no silently shorter
+    or longer run); problems name the field ``stop``."""
+    if not (math.isfinite(stop) and math.isfinite(step) and stop > 0 and step > 0):
+        return 0, [("stop" if not (math.isfinite(stop) and stop > 0) else "step",
+                    f"must be a positive finite number, found {stop if not (math.isfinite(stop) and stop > 0) else step:g}")]
+    ratio = stop / step
+    n = round(ratio)
+    if ratio < 1 - STEPS_TOL:
+        return 0, [("stop", f"stop {stop:g} s is shorter than one step ({step:g} s): nothing would run; "
+                            f"use stop ≥ {step:g} s or a smaller step")]
+    if abs(ratio - n) > STEPS_TOL * max(1.0, ratio):
+        lo, hi = math.floor(ratio), math.ceil(ratio)
+        return 0, [("stop", f"stop {stop:g} s is not a whole number of steps of {step:g} s ({ratio:.6g} steps): "
+                            f"use stop {lo * step:.10g} or {hi * step:.10g} s, or a step that divides {stop:g} s")]
+    return n, []

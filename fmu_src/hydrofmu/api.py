@@ -5,10 +5,12 @@ command line (``hydrofmu build``/``run``) is a thin layer over them.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 
 from . import scene as _scene
+from .errors import InputError
 from .scene import Scene
 
 if TYPE_CHECKING:
@@ -112,16 +114,26 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
         Time, recorded columns with their units, the run's settings and the manifest
         (``Result.to_csv``, ``Result.plot``).
     """
+    from .cosim.master import check_steps
+    if engine not in (None, "fmpy", "libcosim"):
+        raise InputError("run", None, "engine", f"must be 'fmpy' or 'libcosim', found {engine!r}")
+    for key, value in (("stop", stop), ("step", step)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value) or value <= 0):
+            raise InputError("run", None, key, f"must be a positive finite number, found {value!r}")
     folder = source
     if isinstance(source, Scene) or Path(source).suffix == ".toml":
-        folder = build(source, out, log=log)
+        scene = source if isinstance(source, Scene) else load_scene(source)
+        # the run's own stop/step checked against the scene's before anything is built
+        check_steps(stop or scene.run["stop"], step or scene.run["step"], algorithm or scene.run["algorithm"], "run")
+        folder = build(scene, out, log=log)
+    elif not (Path(folder) / "manifest.json").is_file():
+        raise InputError(folder, None, "source", "not a scene (.toml) nor a built scene folder (no manifest.json)")
     from .cosim.libcosim import engine_for
     engine = engine_for(folder, algorithm, engine)
     if engine == "libcosim":
         from .cosim.libcosim import run as run_libcosim
         return run_libcosim(folder, stop=stop, step=step, record=record, algorithm=algorithm)
-    if engine != "fmpy":
-        raise ValueError(f"engine must be 'fmpy' or 'libcosim', found {engine!r}")
     from .cosim.master import run as run_fmpy
     return run_fmpy(folder, stop=stop, step=step, algorithm=algorithm, record=record, parameters=parameters)
 

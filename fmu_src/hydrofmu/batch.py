@@ -33,14 +33,17 @@ import sys
 import tempfile
 import threading
 import time
-import tomllib
 import uuid
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, InputWarning
+from .names import did_you_mean, unknown
+from .textfile import read_toml
+from .writable import check_folder
 
 RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorithm"}
 # scene keys the FMUs expose: key -> FMU variable name (in every FMU that has it)
@@ -92,15 +95,33 @@ def _canonical(key):
     return RUN_ALIASES.get(key, key)
 
 
-def _knobs(p, table, where):
-    """A table of knobs with canonical keys; values must be numbers, strings, booleans or
-    arrays of numbers (what a scene holds)."""
-    out = {}
+def _flat(table, prefix=""):
+    """(key path, value) of a table of knobs: a TOML dotted key (``run.stop = 5``, a nested
+    table) reads as the quoted one (``"run.stop" = 5``)."""
     for key, value in table.items():
-        if not isinstance(key, str) or not key:
+        path = f"{prefix}.{key}" if prefix else str(key)
+        if isinstance(value, dict) and value:
+            yield from _flat(value, path)
+        else:
+            yield path, value
+
+
+def _knobs(p, table, where, seen=None):
+    """A table of knobs with canonical keys; values must be numbers, strings, booleans or
+    arrays of numbers (what a scene holds).  ``seen`` (canonical key → how it was written
+    and where) spans the tables that make one case: a knob given twice is an error."""
+    out = {}
+    seen = {} if seen is None else seen
+    for key, value in _flat(table):
+        if not key:
             p.add(f"{where}.{key}", "expected a key path")
             continue
-        out[_canonical(key)] = value
+        canonical = _canonical(key)
+        if canonical in seen:
+            p.add(f"{where}.{key}", f"given twice: also {seen[canonical]} (one value per knob)")
+            continue
+        seen[canonical] = f"{where + '.' if where else ''}{key}"
+        out[canonical] = value
     return out
 
 
@@ -112,12 +133,7 @@ def load_cases(source, base=None) -> Batch:
         path, doc = Path(base or ".") / "<cases>", source
     else:
         path = Path(source)
-        try:
-            doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-        except OSError as exc:
-            raise InputError(path, None, "file", f"cannot read case file ({exc.strerror})") from None
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise InputError(path, getattr(exc, "lineno", None), "toml", str(exc)) from None
+        doc = read_toml(path, "case file")
     p = Problems(path)
     p.known_keys(doc, "", FILE_KEYS)
     name = p.string(doc, "scene", "scene")
@@ -129,19 +145,22 @@ def load_cases(source, base=None) -> Batch:
             or not all(isinstance(o, str) and "." in o for o in outputs)):
         p.add("outputs", "expected a non-empty array of 'instance.variable' names")
         outputs = []
-    fixed = {}
+    fixed, seen = {}, {}
     for key in ("stop", "step"):
         if key in doc and p.number(doc, key, key, positive=True) is not None:
             fixed[f"run.{key}"] = float(doc[key])
+            seen[f"run.{key}"] = f"{key} (top level)"
     if "algorithm" in doc and p.choice(doc, "algorithm", "algorithm", ("jacobi", "gauss-seidel")):
         fixed["run.algorithm"] = doc["algorithm"]
+        seen["run.algorithm"] = "algorithm (top level)"
     transient = p.number(doc, "transient", "transient", 0.0, nonneg=True)
     series = doc.get("series", False)
     if not isinstance(series, bool):
         p.add("series", f"expected true or false, found {series!r}")
-    fixed.update(_knobs(p, p.table(doc, "set", "set", required=False) or {}, "set"))
+    fixed.update(_knobs(p, p.table(doc, "set", "set", required=False) or {}, "set", seen))
     matrix = {}
-    for key, values in _knobs(p, p.table(doc, "matrix", "matrix", required=False) or {}, "matrix").items():
+    shared = dict(seen)   # the top level, [set] and [matrix] make every case
+    for key, values in _knobs(p, p.table(doc, "matrix", "matrix", required=False) or {}, "matrix", shared).items():
         values = values if isinstance(values, list) else [values]
         if not values:
             p.add(f"matrix.{key}", "expected at least one value")
@@ -150,18 +169,136 @@ def load_cases(source, base=None) -> Batch:
     if not isinstance(extra, list) or not all(isinstance(c, dict) for c in extra):
         p.add("cases", "expected an array of tables ([[cases]])")
         extra = []
+    # a single case may override a shared knob (its own value), not give one twice itself
     extra = [_knobs(p, c, f"cases[{i}]") for i, c in enumerate(extra)]
     batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True)
     built = scene is not None and scene.is_dir()
     for key in batch.keys:
         first = key.split(".", 1)[0].split("[", 1)[0]
-        if first in SCENE_SECTIONS and built and key not in EXPOSED and not key.startswith("run."):
+        if built and key.startswith("run.") and key not in RUN_ALIASES.values():
+            p.add(key, "a built folder runs with stop, step and algorithm only: name the scene file to change "
+                       f"{key}{did_you_mean(key, RUN_ALIASES.values())}")
+        elif first in SCENE_SECTIONS and built and key not in EXPOSED and not key.startswith("run."):
             p.add(key, "the build bakes this in: name the scene file, not a built folder")
         elif first not in SCENE_SECTIONS and "." not in key:
             p.add(key, f"expected a scene key path ({', '.join(SCENE_SECTIONS)}…), 'instance.variable', "
                        "or stop/step/algorithm")
     p.raise_if_any()
     return batch
+
+
+def _first_values(batch):
+    """{knob: its first value in the file} (matrix knobs: their first value)."""
+    out = {}
+    for case in [batch.fixed, {k: v[0] for k, v in batch.matrix.items() if v}, *batch.extra]:
+        for key, value in case.items():
+            out.setdefault(key, value)
+    return out
+
+
+def _steps_of(key):
+    import re
+    return [int(x[1:-1]) if x.startswith("[") else x for x in re.findall(r"\[\d+\]|[^.\[\]]+", key)]
+
+
+def _near(doc, key):
+    """Key paths of the scene ``doc`` near ``key``: the names at the first step it misses."""
+    node, prefix = doc, ""
+    for step in _steps_of(key):
+        if isinstance(step, int):
+            if not isinstance(node, list) or step >= len(node):
+                return [f"{prefix}[{i}]" for i in range(len(node))] if isinstance(node, list) else []
+            node, prefix = node[step], f"{prefix}[{step}]"
+            continue
+        if not isinstance(node, dict) or step not in node:
+            return [f"{prefix}.{k}" if prefix else k for k in node] if isinstance(node, dict) else []
+        node, prefix = node[step], f"{prefix}.{step}" if prefix else step
+    return []
+
+
+def check_knobs(batch):
+    """Every knob of a case file checked against its scene before anything is built or run:
+    a scene key path must exist in the scene (or be a key its table allows), a stop must be a
+    whole number of steps.  One InputError naming the case file, the knob and the closest
+    valid names."""
+    import copy
+    from .scene import load_scene, override
+    if batch.scene.is_dir():
+        run = json.loads((batch.scene / "manifest.json").read_text())["run"]
+    else:
+        doc = read_toml(batch.scene, "scene")
+        first = {k: v for k, v in _first_values(batch).items()
+                 if k.split(".", 1)[0].split("[", 1)[0] in SCENE_SECTIONS and k not in EXPOSED}
+        for key, value in first.items():
+            try:
+                override(copy.deepcopy(doc), key, value, batch.scene)
+            except InputError as exc:
+                raise InputError(batch.path, None, key, f"not in scene {batch.scene.name}: {exc.message}"
+                                                        f"{did_you_mean(key, _near(doc, key))}") from None
+        with warnings.catch_warnings():   # the scene's warnings are said by the cases' own loads
+            warnings.simplefilter("ignore", InputWarning)
+            if first:
+                _check_scene_keys(batch, first)
+            if not {"run.stop", "run.step"} & set(batch.keys):
+                return None
+            try:
+                run = load_scene(batch.scene).run
+            except InputError:
+                return None   # the scene's own error is every case's
+    _check_case_steps(batch, run)
+
+
+def _check_scene_keys(batch, first):
+    """Scene knobs ``first`` ({key: a value}) whose key the scene does not allow: InputError."""
+    from .scene import load_scene
+    try:
+        load_scene(batch.scene, first)
+    except InputError as exc:
+        for key in first:
+            if key in getattr(exc, "unknown", {}):
+                parent = key.rsplit(".", 1)[0]
+                valid = [f"{parent}.{k}" for k in exc.unknown[key]]
+                raise InputError(batch.path, None, key, f"unknown knob: {batch.scene.name} has no key {key}"
+                                                        f"{did_you_mean(key, valid)}") from None
+
+
+def _check_case_steps(batch, run):
+    """stop a whole number of steps in every case that sets stop or step."""
+    from .admissible import whole_steps
+    number = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool)
+    def check(stop, step, knobs):
+        if not ({"run.stop", "run.step"} & set(knobs)) or "run.preset" in knobs:
+            return   # the scene's own settings (checked by the scene), or a preset's step per case
+        if number(stop) and number(step) and stop > 0 and step > 0:
+            for field_, message in whole_steps(stop, step)[1]:
+                raise InputError(batch.path, None, f"run.{field_}", f"{message} (stop {stop:g}, step {step:g})")
+    fixed = batch.fixed
+    if batch.matrix or not batch.extra:
+        stops = batch.matrix.get("run.stop", [fixed.get("run.stop", run["stop"])])
+        steps = batch.matrix.get("run.step", [fixed.get("run.step", run["step"])])
+        knobs = set(fixed) | set(batch.matrix)
+        for stop, step in itertools.product(stops, steps):
+            check(stop, step, knobs)
+    for case in batch.extra:
+        knobs = {**fixed, **case}
+        check(knobs.get("run.stop", run["stop"]), knobs.get("run.step", run["step"]), knobs)
+
+
+def check_names(batch, variables):
+    """Outputs and 'instance.variable' knobs against the FMUs' variables ({name: causality}):
+    one InputError naming the case file, the name and the closest valid names."""
+    for name in batch.outputs:
+        if name not in variables:
+            raise InputError(batch.path, None, "outputs", unknown("output", name, list(variables)))
+    settable = [n for n, c in variables.items() if c in ("input", "parameter")]
+    direct = [k for k in batch.keys if k not in EXPOSED and k.split(".", 1)[0].split("[", 1)[0] not in SCENE_SECTIONS]
+    for key in direct:
+        if key not in settable:
+            raise InputError(batch.path, None, key, unknown("parameter or unconnected input", key, settable))
+        for exposed in EXPOSED:
+            if exposed in batch.keys and key.split(".", 1)[1] == EXPOSED[exposed]:
+                raise InputError(batch.path, None, key, f"given twice: {exposed} sets {EXPOSED[exposed]} of every FMU, "
+                                                        f"{key} too (one value per knob)")
 
 
 # --- variants: one build per distinct set of FMUs -------------------------------------
@@ -436,12 +573,12 @@ def _plan(batch, variants, log):
         errors += [e for e in (variants.exposed_error(k, v) for k, v in exposed.items()) if e]
         parameters = {}
         if variant.variables is not None:
+            if first:
+                check_names(batch, variant.variables)
             wrong = [k for k in direct if variant.variables.get(k) not in ("input", "parameter")]
             missing = [o for o in batch.outputs if o not in variant.variables]
             problems = ([f"{k}: not a parameter or unconnected input of the FMUs" for k in wrong]
                         + ([f"not outputs of the FMUs: {', '.join(missing)}"] if missing else []))
-            if problems and first:
-                raise InputError(batch.path, None, "outputs" if missing else wrong[0], "; ".join(problems))
             errors += problems
             for key, value in exposed.items():
                 names = [n for n, c in variant.variables.items()
@@ -477,7 +614,19 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
     if series is not None:
         batch.series = series
     log = log or (lambda text: print(text, file=sys.stderr))
-    out = Path(out)
+    out = Path(check_folder(out, "out"))
+    check_knobs(batch)
+    # a batch refused before its first case is recorded leaves no folder it made
+    made = next((p for p in [out, *out.parents][::-1] if not p.exists()), None)
+    try:
+        return _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, log, window)
+    except InputError:
+        if made is not None and not (out / "cases").exists():
+            shutil.rmtree(made, ignore_errors=True)
+        raise
+
+
+def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, log, window):
     variants = Variants(batch, out, log)
     token = uuid.uuid4().hex[:12]
     ids = []

@@ -8,7 +8,8 @@ IDOF_B = j) is K[(P, i), (Q, j)], i.e. the SIMO element convention with A = P, B
 ``write_simo`` writes them as a SIMO deck (BODY DATA groups first), ``plot_quality`` draws A(ω)
 and B(ω) rebuilt from (A∞, K) against the database.
 """
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,6 +28,7 @@ class BemCouplings:
     radiation: Radiation
     dofs: list
     names: dict
+    checks: list = field(default_factory=list)
 
     @property
     def labels(self):
@@ -55,8 +57,14 @@ class BemCouplings:
             lines.append(f"  coupling {c.name} ({c.body_a}, {c.body_b}): {len(c.kernels)} kernels; rebuilt A worst "
                          f"{ea[ia]:.3g} % ({self.labels[rows[ia[0]]]}, {self.labels[cols[ia[1]]]}), B worst "
                          f"{eb[ib]:.3g} % ({self.labels[rows[ib[0]]]}, {self.labels[cols[ib[1]]]}) of each curve's peak")
-        lines += [f"  WARNING: {w}" for w in r.warnings]
+        lines += [f"  WARNING: {w}" for w in self.warnings]
         return lines
+
+    @property
+    def warnings(self):
+        """What a reviewer would query, legal all the same: the file's (``BemData.warnings``),
+        negative radiation damping, a short kernel, the transform's own."""
+        return list(self.data.warnings) + self.checks + list(self.radiation.warnings)
 
     def _blocks(self):
         """(coupling, its rows, its columns in the transform's matrices)."""
@@ -79,6 +87,10 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
     ``<a>`` and ``<a>_<b>`` without one.  Raises InputError naming the file and the field.
     """
     path = data.path
+    for name, value in (("timdel", timdel), ("kernel_length", length), ("symmetry_tolerance", symmetry_tol)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value) or value <= 0):
+            raise InputError(path, None, name, f"must be a positive finite number, found {value!r}")
     for b in bodies:
         if b not in data.bodies:
             raise InputError(path, None, "body", f"{b!r} is not a body of the result (it has: {', '.join(data.bodies)})")
@@ -114,6 +126,12 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
                          f"√(A_ii·A_jj) > {100 * exc.tol:g} % (symmetry_tolerance)") from None
     except GridError as exc:
         raise InputError(path, None, exc.field, str(exc)) from None
+    checks = _negative_damping(data, keep, [label(bodies[b], k) for b, k in kept])
+    samples = rad.kernels.shape[-1] - 1
+    if samples < KERNEL_MIN_STEPS:
+        checks.append(f"{path}: kernel length {samples * rad.timdel:g} s is only {samples} TIMDEL ({rad.timdel:g} s): "
+                      f"the memory is cut after {samples} steps; fewer than {KERNEL_MIN_STEPS} rarely holds a "
+                      "retardation function's decay")
     out = []
     order = [b for b in data.bodies if b in bodies]
     for p, bp in enumerate(order):
@@ -130,7 +148,26 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
             na, nb = bodies[bp], bodies[bq]
             name = "_".join(([prefix] if prefix else []) + ([na] if bp == bq else [na, nb]))
             out.append(CouplingData(name, ("from BEM", path), na, nb, am, rad.timdel, kernels, path, None))
-    return BemCouplings(data, out, rad, kept, dict(bodies))
+    return BemCouplings(data, out, rad, kept, dict(bodies), checks)
+
+
+KERNEL_MIN_STEPS = 5      # a kernel of fewer TIMDEL than this is said out loud
+NEGATIVE_DAMPING = 1e-3   # B_ii(ω) below −this × max|B_ii| is said out loud (noise near zero is not)
+
+
+def _negative_damping(data, keep, labels):
+    """Warnings for diagonal radiation damping B_ii(ω) < 0 beyond noise: energy flowing into
+    the body from the waves it radiates, unphysical for a radiation problem."""
+    out = []
+    for r, i in enumerate(keep):
+        b = data.damping[:, i, i]
+        peak = np.max(np.abs(b))
+        low = int(np.argmin(b))
+        if peak > 0 and b[low] < -NEGATIVE_DAMPING * peak:
+            out.append(f"{data.path}: radiation_damping[{labels[r]}, {labels[r]}] is negative at "
+                       f"{int(np.sum(b < -NEGATIVE_DAMPING * peak))} frequencies, down to {b[low]:.4g} at ω = "
+                       f"{data.omega[low]:g} rad/s ({100 * b[low] / peak:.3g} % of its peak)")
+    return out
 
 
 def write_simo(result, path):

@@ -1,15 +1,20 @@
 """Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
+import json
 import math
 import os
 import sys
 import warnings
+import zipfile
 from pathlib import Path
 
 from .api import DEFAULT_OUT, outputs
 from .cosim.master import describe
+from .cosim.master import check_steps
 from .errors import InputError, InputWarning
+from .names import did_you_mean
+from .writable import check_folder, check_outputs, keep
 
 
 def scenes_in(paths, models="models"):
@@ -23,18 +28,21 @@ def scenes_in(paths, models="models"):
 
 
 def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
-    """Validate every scene first, then build each one; returns {scene name: folder}
-    (``check``: every check of the build, nothing written; the folders are None)."""
+    """Validate every scene (files or loaded Scenes) first, then build each one; returns
+    {scene name: folder} (``check``: every check of the build, nothing written; the folders are None)."""
     from .fmi.build import build_scene
-    from .scene import load_scene
+    from .scene import Scene, load_scene
 
-    scenes = [load_scene(p) for p in paths]  # all validated before anything is written
+    # all validated before anything is written
+    scenes = [p if isinstance(p, Scene) else load_scene(p) for p in paths]
     names = {}
     for scene in scenes:
         if scene.name in names:
             raise InputError(scene.path, None, "scene.name", f"{scene.name!r} is also the name of "
                                                              f"{names[scene.name]}: each scene builds into its own folder")
         names[scene.name] = scene.path
+    if not check:
+        check_folder(outdir, "-o")
     folders = {}
     for s in scenes:
         folders[s.name] = build_scene(s, outdir, log=log, check=check)
@@ -43,34 +51,55 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
     return folders
 
 
-def check_run(folder=None, csv=None, png=None, step=None, stop=None):
-    """Bad run arguments as one InputError, before anything is built or written."""
+def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, algorithm=None, out=None):
+    """Bad run arguments as one InputError, before anything is built or written: step and
+    stop positive, stop a whole number of steps (``run``: the scene's or the built folder's
+    [run] settings, for what the command line leaves out), every output writable."""
     for key, value in (("step", step), ("stop", stop)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, f"--{key}", f"must be a positive finite number, found {value:g}")
-    for out in (csv, png):
-        if out is not None and not Path(out).parent.is_dir():
-            raise InputError(out, None, "output file", f"folder {Path(out).parent} does not exist")
     if folder is not None and not (Path(folder) / "manifest.json").is_file():
         raise InputError(folder, None, "scene", "not a scene .toml nor a built scene folder (no manifest.json)")
+    if run is None and folder is not None:
+        run = json.loads((Path(folder) / "manifest.json").read_text())["run"]
+    if run is not None:
+        given = [f"--{k}" for k, v in (("stop", stop), ("step", step)) if v is not None]
+        check_steps(stop or run["stop"], step or run["step"], algorithm or run["algorithm"],
+                    "command line" if given else run.get("source", folder),
+                    {"stop": "--stop", "step": "--step"} if given else {"stop": "run.stop", "step": "run.step"})
+    check_outputs(files=(csv, png), folders=(out,))
 
 
-def run_folder(folder, engine=None, csv=None, png=None, **kw):
+def _stderr(text):
+    print(text, file=sys.stderr)
+
+
+def run_folder(folder, engine=None, csv=None, png=None, log=_stderr, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
-    an ECCO run, else fmpy); write CSV/PNG."""
+    an ECCO run, else fmpy); write CSV/PNG (checked writable first; a write that fails after
+    the run goes to a fallback folder: ``written`` maps each asked path to the one written)."""
     from .cosim.libcosim import engine_for
     folder = Path(folder)
-    check_run(folder, csv, png, kw.get("step"), kw.get("stop"))
+    check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"))
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
     else:
         from .cosim.master import run
     result = run(folder, **kw)
-    if csv:
-        result.to_csv(csv)
-    if png:
-        result.plot(png)
+    result.written = {}
+    for path, write in ((csv, result.to_csv), (png, result.plot)):
+        if path:
+            result.written[Path(path)] = keep(write, path, log)[0]
     return result
+
+
+def _wrote(result):
+    """'wrote a and b' of a command's outputs (``result.written``: asked path → path written);
+    the exit code: 1 when one went to a fallback folder."""
+    moved = [asked for asked, got in result.written.items() if got != asked]
+    text = " and ".join(str(p) for p in result.written.values())
+    return f"wrote {text}" + (f" ({len(moved)} of them not where asked: see the warning)" if moved else ""), \
+        (1 if moved else 0)
 
 
 def validate(paths):
@@ -80,6 +109,11 @@ def validate(paths):
     if missing:
         raise InputError(missing[0], None, "path", "no such FMU or folder")
     fmus = [f for p in map(Path, paths) for f in (sorted(p.rglob("*.fmu")) if p.is_dir() else [p])]
+    if not fmus:
+        raise InputError(paths[0], None, "path", "no FMU (*.fmu) in the folder")
+    for fmu in fmus:
+        if not zipfile.is_zipfile(fmu):
+            raise InputError(fmu, None, "FMU", "not an FMU (an FMU is a zip archive)")
     problems = 0
     for fmu in fmus:
         found = validate_fmu(str(fmu))
@@ -98,15 +132,21 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
     from .bem import couplings, plot_quality, write_simo
     from .decks.bem import read_bem
     from .physics.radiation import SYMMETRY_TOL
+    for option, value in (("--ulen", ulen), ("--rho", rho), ("--timdel", timdel), ("--kernel-length", kernel_length),
+                          ("--symmetry-tolerance", symmetry_tolerance)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise InputError("command line", None, option, f"must be a positive finite number, found {value:g}")
+    check_outputs(files=(out, png))
     data = read_bem(result, ulen=ulen, rho=rho)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
-                     symmetry_tolerance or SYMMETRY_TOL)
+                     SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance)
     for line in made.report():
         log(line)
-    write_simo(made, out)
-    log(f"wrote {out}: couplings {', '.join(c.name for c in made.couplings)}")
+    made.written = {Path(out): keep(lambda p: write_simo(made, p), out, _stderr)[0]}
+    log(f"wrote {made.written[Path(out)]}: couplings {', '.join(c.name for c in made.couplings)}")
     if png:
-        log(f"wrote {plot_quality(made, png)}")
+        made.written[Path(png)] = keep(lambda p: plot_quality(made, p), png, _stderr)[0]
+        log(f"wrote {made.written[Path(png)]}")
     return made
 
 
@@ -276,32 +316,45 @@ def _main(argv):
     elif args.command == "run":
         folder = Path(args.scene)
         if folder.suffix == ".toml":
-            check_run(None, args.csv, args.png, args.step, args.stop)
-            folder = next(iter(build([folder], args.out).values()))
+            from .scene import load_scene
+            scene = load_scene(folder)
+            # the default CSV/PNG go into OUT, which the build makes: OUT is checked for them
+            check_run(None, args.csv, args.png, args.step, args.stop,
+                      {**scene.run, "source": str(scene.path)}, args.algorithm, args.out)
+            folder = next(iter(build([scene], args.out).values()))
         csv, png = outputs(folder)
         csv, png = args.csv or csv, args.png or png
         result = run_folder(folder, args.engine, csv, png, stop=args.stop, step=args.step,
                             algorithm=args.algorithm)
-        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
-              f"wrote {csv} and {png}")
+        wrote, code = _wrote(result)
+        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)}); {wrote}")
+        return code
     elif args.command == "batch":
         return batch(args)
     elif args.command == "demo":
-        folders = build(scenes_in([]), args.out)
-        unknown = [name for name in args.scene or [] if name not in folders]
-        if unknown:
-            raise InputError("command line", None, "--scene", f"no scene {unknown[0]!r} in models/ "
-                                                              f"(scenes: {', '.join(folders)})")
+        from .scene import load_scene
+        scenes = [load_scene(p) for p in scenes_in([])]
+        names = [s.name for s in scenes]
+        for name in args.scene or []:
+            if name not in names:
+                raise InputError("command line", None, "--scene", f"no scene {name!r} in models/"
+                                                                  f"{did_you_mean(name, names)} (scenes: {', '.join(names)})")
+        folders = build(scenes, args.out)
+        code = 0
         for name in args.scene or folders:
             csv, png = outputs(folders[name])
             result = run_folder(folders[name], "fmpy", csv, png)
-            print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); "
-                  f"wrote {csv} and {png}")
+            wrote, failed = _wrote(result)
+            code = max(code, failed)
+            print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); {wrote}")
+        return code
     elif args.command == "bem2simo":
-        bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
-                 args.symmetry_tolerance, args.png)
+        made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
+                        args.symmetry_tolerance, args.png)
+        return _wrote(made)[1]
     elif args.command == "bench":
         from .bench.run import main as bench
+        check_folder(args.out, "-o")
         bench(args.out, args.part, args.quick)
     return 0
 

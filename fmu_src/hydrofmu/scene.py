@@ -6,7 +6,6 @@ and raises one InputError listing them all before anything is built.  Effect dat
 comes inline or from a vendor deck (path relative to the scene file + the name of the
 body/structure in the deck).  See the README for the full format.
 """
-import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +16,7 @@ from . import admissible
 from .description import Effect, HydroCoupling, Kernel
 from .errors import InputError, InputWarning
 from .names import did_you_mean
-from .textfile import read_text
+from .textfile import read_text, read_toml
 
 ACCEL_MODES = ("export", "explicit")
 
@@ -55,6 +54,7 @@ class Scene:
     joints: dict = field(default_factory=dict)
     couplings: list = field(default_factory=list)
     current_profile: list = None     # [[z m, speed m/s, direction deg], ...] or None (uniform)
+    warnings: list = field(default_factory=list)   # suspicious but legal input, said at load (InputWarning)
 
 
 class Problems:
@@ -536,6 +536,12 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
     except InputError as exc:
         problems.add(f"{where}.bem", str(exc))
         return []
+    left = [b for b in data.bodies if b not in mapping]
+    if left:
+        problems.warn(f"{where}.bodies", f"{path} has bodies {', '.join(left)} not mapped to scene bodies: their "
+                                         "couplings with the mapped ones are left out")
+    for text in result.warnings:
+        problems.warn(f"{where}.bem", text)
     return [_coupling(c.name, c.body_a, c.body_b, c, knobs, bem=result) for c in result.couplings]
 
 
@@ -665,14 +671,24 @@ def _body(problems, name, table, where):
 def load_scene(path, overrides=None):
     """Read and validate a scene file.  Raises one InputError naming the file and the
     key path of every problem; returns a Scene whose effect data is ready for kernels.
-    ``overrides``: {key path: value} replacing values of the file (``override``)."""
+    ``overrides``: {key path: value} replacing values of the file (``override``).
+    Suspicious but legal input is an InputWarning (issued again here, for the caller's
+    handlers) and kept in ``Scene.warnings`` (the build writes them into the manifest)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InputWarning)
+        try:
+            scene = _load_scene(path, overrides)
+        finally:
+            said = list(caught)
+    for w in said:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    scene.warnings = list(dict.fromkeys(str(w.message) for w in said if issubclass(w.category, InputWarning)))
+    return scene
+
+
+def _load_scene(path, overrides=None):
     path = Path(path)
-    text = read_text(path, "scene")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        line = getattr(exc, "lineno", None)
-        raise InputError(path, line, "toml", str(exc)) from None
+    doc = read_toml(path, "scene")
     for key, value in (overrides or {}).items():
         override(doc, key, value, path)
     p = Problems(path)
@@ -703,6 +719,9 @@ def load_scene(path, overrides=None):
         "set": sorted(k for k in run if k != "preset"),   # knobs the scene sets itself
     }
     run_cfg["ecco"] = _ecco(p, run, base, run_cfg["step"] if run_cfg["algorithm"] == "ecco" else None)
+    if run_cfg["algorithm"] not in (None, "ecco") and None not in (run_cfg["step"], run_cfg["stop"]):
+        for field_, message in admissible.whole_steps(run_cfg["stop"], run_cfg["step"])[1]:
+            p.add(f"run.{field_}", message)
     if "ecco" in run and run_cfg["algorithm"] not in (None, "ecco"):
         p.add("run.ecco", f"ECCO settings need algorithm = \"ecco\" (the run's algorithm is {run_cfg['algorithm']!r})")
     bodies_t = p.table(doc, "bodies", "bodies") or {}

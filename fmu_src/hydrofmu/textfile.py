@@ -32,3 +32,18 @@ def read_text(path, what="file"):
         line = text.count("\n", 0, text.index("\0")) + 1
         raise InputError(path, line, "encoding", f"{what} is a binary file, not text (NUL byte)")
     return text[1:] if text.startswith(BOM) else text
+
+
+def read_toml(path, what="file"):
+    """The parsed TOML of ``path`` (read as ``read_text``); a syntax error is one InputError
+    naming the file and its line (older tomllib versions say the line only in the text)."""
+    import re
+    import tomllib
+    try:
+        return tomllib.loads(read_text(path, what))
+    except tomllib.TOMLDecodeError as exc:
+        line = getattr(exc, "lineno", None)
+        if line is None:
+            found = re.search(r"\(at line (\d+), column \d+\)", str(exc))
+            line = int(found.group(1)) if found else None
+        raise InputError(path, line, "toml", str(exc)) from None

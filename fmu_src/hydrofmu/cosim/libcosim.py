@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError
 from .bonds import columns, power_bonds
-from .master import run_settings
+from .master import check_names, check_steps, run_settings
 from .result import Result, column_units
 
 NS = 1_000_000_000
@@ -52,6 +52,7 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
                          "libcosim's adaptive ECCO (--algorithm ecco)")
     stop = manifest["run"]["stop"] if stop is None else stop
     step = manifest["run"]["step"] if step is None else step
+    check_steps(stop, step, wanted, "run")
     step_ns = int(round(step * NS))
     settings = run_settings(manifest, step, wanted, stop)
     if wanted == "ecco":
@@ -86,6 +87,8 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
     if record is None:
         record = [f"{name}.{var}" for name in manifest["order"] for var in outputs[name]]
     record = list(record)
+    check_names(record, [f"{name}.{var}" for name in manifest["order"] for var in refs[name]], "run", "record",
+                "'instance.variable'")
     if wanted == "ecco":
         bonds = power_bonds(manifest)
         if not bonds:

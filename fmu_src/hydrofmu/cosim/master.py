@@ -26,7 +26,9 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
+from ..admissible import whole_steps
 from ..errors import InputError
+from ..names import unknown
 from .result import Result
 
 
@@ -304,6 +306,29 @@ def load(folder, parameters=None):
     return System(manifest, instances, parameters)
 
 
+def check_steps(stop, step, algorithm, where, fields=None):
+    """The number of steps of a fixed-step run; InputError (naming ``where`` and the field,
+    ``fields`` renaming 'stop'/'step', e.g. to '--stop') when ``stop`` is not a whole
+    number ≥ 1 of ``step``.  ECCO (adaptive step, ``step`` its first one) ends at the first
+    time point at or after ``stop``: any positive stop, None returned."""
+    n, problems = whole_steps(stop, step)
+    if algorithm == "ecco" and not (problems and problems[0][1].startswith("must")):
+        return None
+    if problems:
+        field, message = problems[0]
+        raise InputError(where, None, (fields or {}).get(field, field), message)
+    return n
+
+
+def check_names(names, valid, where, field, what="variable"):
+    """InputError naming the first of ``names`` not in ``valid`` with the closest valid names."""
+    valid = list(valid)
+    known = set(valid)
+    for name in names:
+        if name not in known:
+            raise InputError(where, None, field, unknown(what, name, valid))
+
+
 def _check_algorithm(algorithm, where):
     if algorithm == "ecco":
         raise InputError(where, None, "algorithm", "ECCO (adaptive step) runs in libcosim only: use --engine "
@@ -334,9 +359,15 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         step = cfg["step"] if step is None else step
         algorithm = algorithm or cfg["algorithm"]
         _check_algorithm(algorithm, system.manifest.get("source", "run"))
-        n = int(round(stop / step))
+        n = check_steps(stop, step, algorithm, "run")
+        variables = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.vr]
         if record is None:
             record = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.outputs()]
+        check_names(record, variables, "run", "record", "'instance.variable'")
+        if own:
+            check_names(system.parameters, [f"{name}.{v}" for name, inst in system.instances.items()
+                                            for v, c in inst.causality.items() if c in ("parameter", "input")],
+                        "run", "parameters", "parameter or input")
         values = np.empty((n + 1, len(record)))
         progress = n > 2000 if progress is None else progress
         if progress:

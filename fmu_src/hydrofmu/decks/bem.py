@@ -18,8 +18,15 @@ WAMIT (manual, chapter 4): lines ``PER I J Ā [B̄]``, PER the period [s] (the d
 IPEROUT = 1), PER = −1 the infinite period (ω = 0) and PER = 0 the zero period (ω = ∞), both
 with Ā only.  Nondimensional with the length ULEN and the density ρ:
 A = Ā·ρ·L^k, B = B̄·ρ·L^k·ω, k = 3 for I, J ≤ 3 (of each body), 5 for both rotations, 4 mixed.
-Several bodies: I = 6·(body − 1) + k, bodies named "body1", "body2", …  A pair missing at
-a period is zero (WAMIT leaves out what it does not compute).
+Several bodies: I = 6·(body − 1) + k, bodies named "body1", "body2", …  A pair (I, J) missing
+at every period is zero (WAMIT leaves out what it does not compute) and said in ``warnings``;
+a pair present at some periods and missing at others (a truncated or spliced file) is an
+error, and so is a pair of the finite periods missing from the PER = 0 (ω = ∞) rows.
+
+Refused (InputError naming the file and the field): a negative or repeated frequency, two
+ω = ∞ rows, a non-numeric value, a ``rotation_center`` whose bodies are not the dofs'
+bodies.  Said in ``BemData.warnings`` (legal, but a reviewer would ask): no ρ or g in a
+Capytaine dataset.
 """
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,6 +59,7 @@ class BemData:
     g: float = None
     water_depth: float = None
     kind: str = ""
+    warnings: list = field(default_factory=list)
 
     def index(self, body, k):
         """Row/column of (body, dof k) or None."""
@@ -101,7 +109,7 @@ def read_capytaine(path):
     scalars = {}
     for name in ("rho", "g", "water_depth", "forward_speed"):
         if name in ds.coords or name in ds:
-            v = np.atleast_1d(ds[name].values).astype(float)
+            v = _floats(path, name, np.atleast_1d(ds[name].values))
             if v.size != 1:
                 raise InputError(path, None, name, f"{v.size} values {v.tolist()}: select one "
                                                    f"(ds.sel({name}=…)) before exporting")
@@ -118,10 +126,8 @@ def read_capytaine(path):
         raise InputError(path, None, "added_mass", f"expected dimensions (frequency, influenced_dof, radiating_dof), "
                                                    f"found {am.dims}")
     freq = extra[0]
-    if freq == "omega":
-        omega = ds["omega"].values.astype(float)
-    elif "omega" in ds.coords and ds["omega"].dims == (freq,):
-        omega = ds["omega"].values.astype(float)
+    if freq == "omega" or ("omega" in ds.coords and ds["omega"].dims == (freq,)):
+        omega = _floats(path, "omega", ds["omega"].values)
     else:
         raise InputError(path, None, "omega", f"no angular frequency coordinate along {freq!r}")
     rows = [str(x) for x in ds["influenced_dof"].values]
@@ -131,8 +137,9 @@ def read_capytaine(path):
         raise InputError(path, None, "radiating_dof", f"missing dof(s) {', '.join(miss)}: radiating and influenced "
                                                       f"dofs must be the same set")
     order = [cols.index(r) for r in rows]
-    a = am.transpose(freq, "influenced_dof", "radiating_dof").values.astype(float)[:, :, order]
-    b = ds["radiation_damping"].transpose(freq, "influenced_dof", "radiating_dof").values.astype(float)[:, :, order]
+    a = _floats(path, "added_mass", am.transpose(freq, "influenced_dof", "radiating_dof").values)[:, :, order]
+    b = _floats(path, "radiation_damping",
+                ds["radiation_damping"].transpose(freq, "influenced_dof", "radiating_dof").values)[:, :, order]
     dofs, bodies = [], []
     for name in rows:
         body, _, dof = name.rpartition("__")
@@ -151,6 +158,12 @@ def read_capytaine(path):
     fin = np.isfinite(omega) & (omega > 0)
     if np.isnan(omega).any():
         raise InputError(path, None, "omega", "NaN frequency")
+    if np.any(omega < 0):
+        raise InputError(path, None, "omega", f"negative frequency {omega[omega < 0][0]:g} rad/s: ω must be ≥ 0 "
+                                              "(0: the zero-frequency limit, inf: the infinite-frequency one)")
+    if np.sum(omega == np.inf) > 1:
+        raise InputError(path, None, "omega", f"{int(np.sum(omega == np.inf))} rows at ω = inf: one "
+                                              "infinite-frequency added mass expected")
     for name, v in (("added_mass", a), ("radiation_damping", b)):
         sel = fin | inf if name == "added_mass" else fin
         _check_finite(path, name, v[sel], [(freq, omega[sel])] + coords[1:])
@@ -162,13 +175,43 @@ def read_capytaine(path):
     if "rotation_center" in ds.coords or "rotation_center" in ds:
         rc = ds["rotation_center"]
         if "body" in rc.dims:
-            centres = {str(n): rc.sel(body=n).values.astype(float).tolist() for n in rc["body"].values}
+            centres = {str(n): _floats(path, f"rotation_center[{n}]", rc.sel(body=n).values).tolist()
+                       for n in rc["body"].values}
+            if set(centres) != set(bodies):
+                raise InputError(path, None, "rotation_center", f"given for bodies {', '.join(centres)} but the "
+                                 f"dofs name bodies {', '.join(bodies)}: the centres would go unchecked")
+        elif len(bodies) == 1:
+            centres = {bodies[0]: _floats(path, "rotation_center", rc.values).tolist()}
         else:
-            centres = {bodies[0]: rc.values.astype(float).tolist()}
+            raise InputError(path, None, "rotation_center", f"one centre for {len(bodies)} bodies "
+                                                            f"({', '.join(bodies)}): give one per body")
+    missing = [name for name in ("rho", "g") if name not in scalars]
+    warnings = ([f"{path}: {', '.join(missing)} not in the dataset: the coefficients are taken as solved "
+                 f"with the scene's (environment.rho, environment.g); check they match the BEM run"]
+                if missing else [])
     return BemData(str(path), w, a[fin][k], b[fin][k], dofs, bodies,
                    a_inf=a[inf][0] if inf.any() else None, rotation_centers=centres,
                    rho=scalars.get("rho"), g=scalars.get("g"), water_depth=scalars.get("water_depth"),
-                   kind="Capytaine")
+                   kind="Capytaine", warnings=warnings)
+
+
+def _floats(path, name, values):
+    """``values`` as a float array, or an InputError naming the variable and the first value
+    that is not a number."""
+    try:
+        return np.asarray(values).astype(float)
+    except (TypeError, ValueError):
+        flat = np.asarray(values, dtype=object).ravel()
+        bad = next((v for v in flat if not _is_number(v)), flat[0] if flat.size else None)
+        raise InputError(path, None, name, f"not a number: {bad!r}") from None
+
+
+def _is_number(value):
+    try:
+        float(value)
+        return True
+    except (TypeError, ValueError):
+        return False
 
 
 def _single_name(ds):
@@ -231,6 +274,7 @@ def read_wamit(path, ulen, rho):
     periods = sorted((p for p in rows if p > 0), reverse=True)          # increasing ω
     if len(periods) < 3:
         raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 3 needed")
+    warnings = _wamit_pairs(path, rows, periods, first)
     index = sorted({i for r in rows.values() for ij in r for i in ij})
     n = len(index)
     pos = {d: k for k, d in enumerate(index)}
@@ -250,5 +294,27 @@ def read_wamit(path, ulen, rho):
     bodies = [x for x in bodies if any(d[0] == x for d in dofs)]
     return BemData(str(path), omega, a, b, dofs, bodies,
                    a_inf=matrices(rows[0.0], 0) if 0.0 in rows else None,
-                   rho=None, g=None, water_depth=None, kind="WAMIT")
+                   rho=None, g=None, water_depth=None, kind="WAMIT", warnings=warnings)
+
+
+def _wamit_pairs(path, rows, periods, first):
+    """A pair (I, J) given at some finite periods (or at them but not at PER = 0) and missing
+    at others is an error (a truncated or spliced file, read as zeros otherwise); pairs of
+    given dofs missing at every period are zeros by WAMIT's rule, said as a warning."""
+    given = {ij for p in periods for ij in rows[p]}
+    for p in periods + ([0.0] if 0.0 in rows else []):
+        gap = sorted(given - set(rows[p]))
+        if gap:
+            i, j = gap[0]
+            last = max(first[(p, *ij)] for ij in rows[p])
+            what = "the infinite-frequency rows (PER = 0)" if p == 0.0 else f"period {p:g} s"
+            raise InputError(path, last, "I J", f"{len(gap)} pair(s) given at other periods are missing at {what}, "
+                             f"first ({i}, {j}) (its rows end at line {last}): a truncated file? every period "
+                             "must list the same pairs")
+    dofs = sorted({i for ij in given for i in ij})
+    absent = [(i, j) for i in dofs for j in dofs if (i, j) not in given]
+    if not absent:
+        return []
+    shown = ", ".join(f"({i}, {j})" for i, j in absent[:6]) + (", …" if len(absent) > 6 else "")
+    return [f"{path}: {len(absent)} pair(s) of its dofs missing at every period, read as zeros: {shown}"]
 

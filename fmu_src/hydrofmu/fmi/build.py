@@ -221,6 +221,7 @@ def manifest(scene, system, conns):
         "order": [i.name for i in system.instances],
         "connections": conns,
         "bonds": osp.scalar_bonds(osp.bonds(system)),
+        "warnings": list(scene.warnings),   # suspicious but legal input, as the build said it
     }
 
 
@@ -235,7 +236,8 @@ def report_bem(scene, log, folder):
     from ..bem import plot_quality
     for result in bem_results(scene):
         for line in result.report():
-            log(line)
+            if not line.startswith("  WARNING: "):   # said as warnings by the scene already
+                log(line)
         png = plot_quality(result, Path(folder) / f"{Path(result.data.path).stem}_quality.png")
         log(f"  wrote {png.name}")
 
