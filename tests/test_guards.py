@@ -370,7 +370,7 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
     table = [
         (["build", tmp_path / "none.toml"], "none.toml: file: cannot read scene"),
         (["build", tmp_path / "bad.toml"], "bad.toml:1: toml:"),
-        (["build", scene, "-o", afile], "afile: -o: is a file, not a folder"),
+        (["build", scene, "-o", afile], "afile: output folder: is a file, not a folder"),
         (["build"], "models: models: no scene files"),
         (["run", tmp_path / "none.toml"], "none.toml: file: cannot read scene"),
         (["run", scene, "--stop", "1.05", "-o", tmp_path / "o"], "--stop: stop 1.05 s is not a whole number of steps"),
@@ -378,7 +378,7 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
         (["run", tmp_path / "empty"], "empty: scene: not a scene .toml nor a built scene folder"),
         (["batch", tmp_path / "none.toml"], "none.toml: file: cannot read case file"),
         (["batch", tmp_path / "bad.toml"], "bad.toml:1: toml:"),
-        (["batch", cases, "-o", afile], "afile: out: is a file, not a folder"),
+        (["batch", cases, "-o", afile], "afile: output folder: is a file, not a folder"),
         (["batch", cases, "-o", tmp_path / "b"], "cases.toml: environment.current_sped: unknown knob"),
         (["batch", cases, "--workers", "0"], "--workers: expected a positive whole number"),
         (["validate", tmp_path / "none.fmu"], "none.fmu: path: no such FMU or folder"),
@@ -387,7 +387,7 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
         (["bem2simo", tmp_path / "none.nc", "-o", tmp_path / "x.sim"], "none.nc: bem: cannot read"),
         (["bem2simo", junk, "-o", tmp_path / "x.sim"], "junk.fmu: bem: expected a Capytaine NetCDF dataset"),
         (["bem2simo", tmp_path / "none.1", "-o", tmp_path / "x.sim"], "none.1: ulen:"),
-        (["bench", "-o", afile, "--part", "overhead"], "afile: -o: is a file, not a folder"),
+        (["bench", "-o", afile, "--part", "overhead"], "afile: output folder: is a file, not a folder"),
         (["demo", "-o", tmp_path / "d"], "models: models: no scene files"),
     ]
     for args, words in table:

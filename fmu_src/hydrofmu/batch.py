@@ -614,7 +614,7 @@ def run_batch(cases, out, workers=None, scheduler=None, client=None, series=None
     if series is not None:
         batch.series = series
     log = log or (lambda text: print(text, file=sys.stderr))
-    out = Path(check_folder(out, "out"))
+    out = Path(check_folder(out))
     check_knobs(batch)
     # a batch refused before its first case is recorded leaves no folder it made
     made = next((p for p in [out, *out.parents][::-1] if not p.exists()), None)

@@ -42,7 +42,7 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
                                                              f"{names[scene.name]}: each scene builds into its own folder")
         names[scene.name] = scene.path
     if not check:
-        check_folder(outdir, "-o")
+        check_folder(outdir)
     folders = {}
     for s in scenes:
         folders[s.name] = build_scene(s, outdir, log=log, check=check)
@@ -354,7 +354,7 @@ def _main(argv):
         return _wrote(made)[1]
     elif args.command == "bench":
         from .bench.run import main as bench
-        check_folder(args.out, "-o")
+        check_folder(args.out)
         bench(args.out, args.part, args.quick)
     return 0
 
