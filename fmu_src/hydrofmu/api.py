@@ -27,7 +27,7 @@ def load_scene(path: str | Path) -> Scene:
     Parameters
     ----------
     path : str or Path
-        The scene (TOML; format in the README).  Vendor decks it names are read
+        The scene (TOML; format in docs/scenes.md).  Vendor decks it names are read
         relative to it.
 
     Returns

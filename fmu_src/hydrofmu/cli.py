@@ -227,7 +227,7 @@ def make_parser():
     a = sub.add_parser("batch", formatter_class=fmt,
                        description="Run a matrix of load cases (a case file: a scene and the values to vary) on Dask: one table of results (cases.csv, cases.parquet) and plots; exit code 1 when a case failed.",
                        help="run a matrix of load cases (a case file) on Dask: one table, plots")
-    a.add_argument("cases", type=Path, help="case file (TOML, see the README's 'Load-case batches')")
+    a.add_argument("cases", type=Path, help="case file (TOML, see docs/batches.md; example: examples/cases.toml)")
     a.add_argument("-o", "--out", type=Path, help="results folder (default build/batch/<case file name>)")
     where = a.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, help="worker processes of the local Dask cluster (default: cores)")

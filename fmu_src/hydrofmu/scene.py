@@ -4,7 +4,7 @@ A scene is a TOML file (read with the standard library).  Validation collects ev
 problem, each named by the file and the key path (``bodies.barge.effects[1].deck``),
 and raises one InputError listing them all before anything is built.  Effect data
 comes inline or from a vendor deck (path relative to the scene file + the name of the
-body/structure in the deck).  See the README for the full format.
+body/structure in the deck).  The format, key by key: docs/scenes.md.
 """
 import warnings
 from dataclasses import dataclass, field

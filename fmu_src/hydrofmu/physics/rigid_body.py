@@ -437,7 +437,7 @@ class RigidBody:
 
     # -- dynamics -----------------------------------------------------------------------
     def step(self, dt, external_load, load_rate=None):
-        """Advance the state by dt [s] (≥ 0) with the external load [F; M about O] [N, N·m],
+        """Advance the state by dt [s] (≥ 0) with the external load [F; M about O], in [N, N·m],
         global axes, held constant, or varying linearly at ``load_rate`` [N/s, N·m/s] from
         its value at the start of the step.  dt = 0 only replaces the held load.  Returns the
         acceleration after the step (``acceleration``)."""
@@ -474,12 +474,12 @@ class RigidBody:
 
     @property
     def velocity(self):
-        """[v; ω] [m/s, rad/s]: reference-point velocity and angular velocity, global axes."""
+        """[v; ω], in [m/s, rad/s]: reference-point velocity and angular velocity, global axes."""
         return self._y[6:12].copy()
 
     @property
     def acceleration(self):
-        """[a; α] [m/s², rad/s²], global axes, from the current state and the load of the
+        """[a; α], in [m/s², rad/s²], global axes, from the current state and the load of the
         last step (zero before the first step)."""
         return self._eq.accelerations(self._y, self._load, self._start())
 
