@@ -181,8 +181,9 @@ def test_ssp_validates_and_runs_in_libcosim_native(name, scenes, hosts, jacobi, 
 
 
 def test_ssp_contents(scenes):
-    """Units with their SI exponents, parameters bound to the values the build gave, and
-    the default experiment: what an SSP importer reads without opening the FMUs."""
+    """Units with their SI exponents, parameters and inputs bound to their start values
+    (the build's, the FMUs' own), and the default experiment: what an SSP importer reads
+    without opening the FMUs."""
     from xml.etree import ElementTree as ET
     from fmpy import read_model_description
     from hydrofmu.fmi.ssp import SSC, SSD, SSV, base_unit
@@ -200,11 +201,12 @@ def test_ssp_contents(scenes):
     assert base_unit("deg") == {"rad": "1", "factor": repr(np.pi / 180)}
     for comp in root.iter(f"{{{SSD}}}Component"):
         md = read_model_description(str(folder / Path(comp.get("source")).name))
-        start = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
-        bound = {p.get("name"): float(p.find("ssv:Real", ns).get("value")) for p in comp.iter(f"{{{SSV}}}Parameter")}
-        assert bound == start and bound  # rho, g, added mass …
         kinds = {c.get("name"): c.get("kind") for c in comp.iter(f"{{{SSD}}}Connector")}
-        assert all(kinds[p] == "parameter" for p in bound)
+        start = {v.name: float(v.start) for v in md.modelVariables
+                 if v.causality == "parameter" or kinds.get(v.name) == "input"}
+        bound = {p.get("name"): float(p.find("ssv:Real", ns).get("value")) for p in comp.iter(f"{{{SSV}}}Parameter")}
+        assert bound == start and bound  # rho, g, added mass, every connected input …
+        assert {kinds[p] for p in bound} <= {"parameter", "input"}
     assert "rho" in bound or any("added_mass" in p for p in bound)
 
 

@@ -14,7 +14,7 @@ the instances and writes the system files; it asks the physics nothing itself.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -170,7 +170,8 @@ def joint_spring(scene, joint, exported):
 
 
 def _pose(body):
-    return d.Pose(np.array(body.position, float), np.array(body.attitude, float))
+    """The body's state at t = 0, what its dynamics partner outputs then."""
+    return d.Pose(np.array(body.position, float), np.array(body.attitude, float), np.array(body.velocity, float))
 
 
 def _dynamics(scene, instance, members, exported, sides):
@@ -190,7 +191,8 @@ def _dynamics(scene, instance, members, exported, sides):
 
 
 def _loads(scene, body, sides, env):
-    mine = [s for s in sides if target(s) == body.name]
+    mine = [s if s.own else replace(s, velocity=np.array(scene.bodies[s.source].velocity, float))
+            for s in sides if target(s) == body.name]
     motion = {"": body.name}
     motion.update({f"{s.source}.": s.source for s in mine if not s.own})
     names = [f"{e.name} ({e.type})" for e in body.effects] + [f"{s.name} (simo_coupling)" for s in mine]
@@ -198,18 +200,19 @@ def _loads(scene, body, sides, env):
         description=f"hydrodynamic loads on '{body.name}' (scene {scene.name}): "
                     + (", ".join(names) or "no effects"),
         body=body.name, position=np.array(body.position, float), attitude=np.array(body.attitude, float),
-        accel_mode=body.accel_mode, effects=list(body.effects), couplings=mine, environment=env)
+        accel_mode=body.accel_mode, effects=list(body.effects), couplings=mine, environment=env,
+        velocity=np.array(body.velocity, float))
     return Instance(body.name, f"{scene.name}_{body.name}", "load", body.name, fmu, motion,
-                    [("force", body.name, "force")])
+                    [("force", body.name, d.DynamicsBody.load_input(""))])
 
 
 def _connector(scene, joint, exported, env):
     a, b = scene.bodies[joint.a], scene.bodies.get(joint.b)
     motion = {"A.": a.name}
-    forces = [("A.force", a.name, f"{joint.name}.force")]
+    forces = [("A.force", a.name, d.DynamicsBody.load_input(joint.name))]
     if b is not None:
         motion["B."] = b.name
-        forces.append(("B.force", b.name, f"{joint.name}.force"))
+        forces.append(("B.force", b.name, d.DynamicsBody.load_input(joint.name)))
     fmu = d.ConnectorFMU(
         description=f"RIFLEX CONB ball joint '{joint.name}' between '{a.name}' and "
                     f"'{b.name if b is not None else 'earth'}' (codes IRX IRY IRZ = "

@@ -102,9 +102,12 @@ class HydroCoupling:
 @dataclass
 class CouplingSide:
     """One side of a coupling as a load FMU applies it: 'A' is the load on body a from b's
-    motion (A∞), 'B' the load on b from a's motion (A∞ᵀ); ``source``: the driving body."""
+    motion (A∞), 'B' the load on b from a's motion (A∞ᵀ); ``source``: the driving body.
+    ``velocity``: the source's velocity at t = 0, start of the ``<source>.velocity`` inputs
+    (None for the body's own radiation, which reads the body's own velocity input)."""
     coupling: HydroCoupling
     side: str
+    velocity: np.ndarray | None = None
 
     @property
     def name(self) -> str:
@@ -128,8 +131,9 @@ class CouplingSide:
 @dataclass
 class LoadFMU:
     """Hydrodynamic loads on one body: its effects and coupling sides.  ``position``,
-    ``attitude``: the initial pose of the reference point; ``accel_mode``: 'export' |
-    'explicit' (acceleration loads exported as mass or applied as −M·a)."""
+    ``attitude``, ``velocity``: the reference point's state at t = 0 (the motion inputs'
+    start values); ``accel_mode``: 'export' | 'explicit' (acceleration loads exported as
+    mass or applied as −M·a)."""
     description: str
     body: str
     position: np.ndarray
@@ -138,13 +142,16 @@ class LoadFMU:
     effects: list[Effect]
     couplings: list[CouplingSide]
     environment: Environment
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
 
 @dataclass
 class Pose:
-    """Initial position [m] and attitude (roll, pitch, yaw) [rad] of a reference point."""
+    """State at t = 0 of a reference point: position [m], attitude (roll, pitch, yaw) [rad]
+    and velocity (linear [m/s], angular [rad/s], global axes)."""
     position: np.ndarray
     attitude: np.ndarray
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
 
 @dataclass
@@ -180,8 +187,10 @@ class ConnectorFMU:
 class DynamicsBody:
     """One body of a dynamics FMU: mass [kg], inertia [kg·m²] about the CoG in body axes, cog
     [m] from the reference point (body axes), stiffness and damping (6×6, global, about the
-    reference point), initial pose and velocity, exported ``added_mass`` (6×6) and the
-    ``load_sources`` it sums ('' : its load FMU, else a joint's name)."""
+    reference point), initial pose and velocity, exported ``added_mass`` (6×6), the
+    ``load_sources`` it sums ('' : its load FMU, else a joint's name) and ``loads``: each
+    source's load at t = 0, the start values of its load inputs (filled by
+    ``fmi.starts.fill_loads`` from the source FMUs; empty: zero)."""
     name: str
     mass: float
     inertia: np.ndarray
@@ -193,6 +202,12 @@ class DynamicsBody:
     velocity: np.ndarray
     load_sources: list[str]
     added_mass: np.ndarray
+    loads: list[np.ndarray] = field(default_factory=list)
+
+    @staticmethod
+    def load_input(source: str) -> str:
+        """The variable group of the load input from ``source`` (without the body prefix)."""
+        return f"{source}.force" if source else "force"
 
 
 @dataclass

@@ -6,6 +6,9 @@ connected as the build connects them.  ``cosim.master.run(system(scene))`` then 
 exactly as it drives the built FMUs (initialisation, Jacobi / Gauss–Seidel exchange,
 sampling): only the transport differs, Python calls instead of fmpy and the FMI binary.
 Made for many short runs (the stability maps of ``bench.stability``).  A System runs once.
+Unlike a build, it leaves the dynamics' load inputs starting at zero (``fmi.starts`` would
+evaluate every load slave once more): the master exchanges in initialization mode, so a
+run is the same.
 """
 import tempfile
 from pathlib import Path

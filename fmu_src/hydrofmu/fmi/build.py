@@ -22,7 +22,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-from . import model_description, osp
+from . import model_description, osp, starts
 from ..errors import InputError
 from .ssp import write_ssp
 from .. import description
@@ -129,7 +129,7 @@ SLAVES = {description.LoadFMU: "LoadSlave", description.ConnectorFMU: "Connector
 
 def build_fmu(instance, workdir, runtime, shim=True):
     """Build the FMU of an ``assembly.Instance`` into ``workdir``; returns (fmu path, slave
-    introspection)."""
+    introspection, every variable's value at t = 0 (``starts.at_start``))."""
     from pythonfmu.builder import FmuBuilder
 
     model_id = instance.model_id
@@ -147,6 +147,7 @@ def build_fmu(instance, workdir, runtime, shim=True):
                                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         slave = getattr(importlib.import_module(model_id), model_id)(
             instance_name="introspect", resources=str(stage))
+        t0 = starts.at_start(instance.name, slave)   # here: lazy imports still find the staged runtime
     finally:
         sys.path[:] = saved_path
         # a later load of the FMU must import its own copy: the staged one is deleted with
@@ -157,7 +158,7 @@ def build_fmu(instance, workdir, runtime, shim=True):
     if shim:
         from .shim import install_shim
         install_shim(fmu)
-    return Path(fmu), slave
+    return Path(fmu), slave, t0
 
 
 def bytecode(source, name):
@@ -184,7 +185,8 @@ def rewrite_model_description(fmu, slave):
                 folder, _, module = name.rpartition("/")
                 dst.writestr(f"{folder}/__pycache__/{module[:-3]}.{tag}.pyc", bytecode(data, name))
             if item.filename == "modelDescription.xml":
-                data = model_description.complete(data, slave.units, slave.dependencies)
+                data = model_description.complete(data, slave.units, slave.dependencies,
+                                                  {v.name: slave._start[vr] for vr, v in slave.vars.items()})
             dst.writestr(item, data)
     tmp.replace(fmu)
 
@@ -205,6 +207,15 @@ def connections(system, slaves):
             dyn, dp = system.dynamics[body]
             conns += [[inst.name, f"{out}[{i}]", dyn, f"{dp}{inp}[{i}]"] for i in range(1, 7)]
     return conns
+
+
+def input_starts(slaves, conns):
+    """{instance: {connected input: start value}}: what the system files declare besides
+    the FMUs' own modelDescription.xml."""
+    out = {}
+    for _, _, dst, inp in conns:
+        out.setdefault(dst, {})[inp] = starts.start_of(slaves[dst], inp)
+    return out
 
 
 def manifest(scene, system, conns):
@@ -272,18 +283,22 @@ def build_scene(scene, outdir, shim=True, log=print, check=False):
 def _build_into(scene, outdir, target, system, runtime, shim, log):
     with tempfile.TemporaryDirectory(prefix=f".{scene.name}-", dir=outdir) as tmp:
         work = Path(tmp)
-        slaves = {}
-        for inst in system.instances:
-            fmu, slaves[inst.name] = build_fmu(inst, work, runtime, shim)
+        slaves, t0 = {}, {}
+        for inst in system.instances:   # load and joint FMUs first: the dynamics start at their loads
+            if inst.kind == "dynamics":
+                starts.fill_loads(system, t0)
+            fmu, slaves[inst.name], t0[inst.name] = build_fmu(inst, work, runtime, shim)
             log(f"built {fmu.name}")
         conns = connections(system, slaves)
+        starts.check(conns, slaves, t0)
         bonds = osp.bonds(system)
         result = work / "fmus"
         report_bem(scene, log, result)
         (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns), indent=2))
         for model_id, text in osp.model_descriptions(system, slaves, bonds).items():
             (result / f"{model_id}_OspModelDescription.xml").write_bytes(text)
-        (result / "OspSystemStructure.xml").write_text(osp.system_structure(system, conns, bonds, scene.run["step"]))
+        (result / "OspSystemStructure.xml").write_text(
+            osp.system_structure(system, conns, bonds, scene.run["step"], input_starts(slaves, conns)))
         write_ssp(result / f"{scene.name}.ssp", scene.name,
                   {i.name: result / f"{i.model_id}.fmu" for i in system.instances}, conns,
                   scene.run["stop"], scene.run["step"])

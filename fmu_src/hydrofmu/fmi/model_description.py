@@ -38,12 +38,14 @@ def base_unit(unit):
     return base
 
 
-def complete(xml_text, units, dependencies, description=None):
-    """Return modelDescription.xml text with units and a full ModelStructure.
+def complete(xml_text, units, dependencies, starts=None, description=None):
+    """Return modelDescription.xml text with units, exact start values and a full ModelStructure.
 
     ``units``: variable name -> unit (a key of UNITS).  ``dependencies``: output name ->
     names of the inputs it depends on directly (feedthrough); an output absent from it
-    depends on no input (it is a state).
+    depends on no input (it is a state).  ``starts``: variable name -> start value, written
+    in full (repr: the float itself, where pythonfmu writes 16 digits) wherever the
+    variable has a start.
     """
     root = ET.fromstring(xml_text)
     if description:
@@ -55,6 +57,8 @@ def complete(xml_text, units, dependencies, description=None):
     for sv in variables:
         unit = units.get(sv.get("name"))
         real = sv.find("Real")
+        if real is not None and real.get("start") is not None and starts and sv.get("name") in starts:
+            real.set("start", repr(float(starts[sv.get("name")])))
         if unit is None or real is None:
             continue
         if unit not in UNITS:

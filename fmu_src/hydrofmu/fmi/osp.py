@@ -172,10 +172,12 @@ def model_descriptions(system, slaves, bonds_: list[Bond]) -> dict:
     return out
 
 
-def system_structure(system, conns: list, bonds_: list[Bond], step: float) -> str:
-    """OspSystemStructure.xml text: the simulators, every bond as a connection of two ports
-    (linear and angular) and every other connection of ``conns`` as a plain one.  A bond
-    stands for scalar connections that must all be in ``conns``: the system is the same."""
+def system_structure(system, conns: list, bonds_: list[Bond], step: float, starts: dict | None = None) -> str:
+    """OspSystemStructure.xml text: the simulators (each with ``starts[instance]``, {input:
+    value}, as its InitialValues: the FMUs' own start values, fmi.starts), every bond as a
+    connection of two ports (linear and angular) and every other connection of ``conns`` as
+    a plain one.  A bond stands for scalar connections that must all be in ``conns``: the
+    system is the same."""
     covered = bond_connections(bonds_)
     missing = covered - {tuple(c) for c in conns}
     if missing:
@@ -186,7 +188,12 @@ def system_structure(system, conns: list, bonds_: list[Bond], step: float) -> st
     ET.SubElement(root, "Algorithm").text = "fixedStep"
     sims = ET.SubElement(root, "Simulators")
     for inst in system.instances:
-        ET.SubElement(sims, "Simulator", name=inst.name, source=f"{inst.model_id}.fmu")
+        sim = ET.SubElement(sims, "Simulator", name=inst.name, source=f"{inst.model_id}.fmu")
+        values = (starts or {}).get(inst.name)
+        if values:
+            initial = ET.SubElement(sim, "InitialValues")
+            for var, value in values.items():
+                ET.SubElement(ET.SubElement(initial, "InitialValue", variable=var), "Real", value=repr(float(value)))
     cons = ET.SubElement(root, "Connections")
     for src, svar, dst, dvar in conns:
         if (src, svar, dst, dvar) not in covered:

@@ -126,6 +126,7 @@ class ArraySlave(Fmi2Slave):
         self.config = description.read(self.resources)   # this FMU's typed description
         self.description = self.config.description
         self._start = []        # start values while registering
+        self.unknown_start = set()   # inputs whose value at t = 0 the build cannot know (start 0)
         self.units = {}         # variable name -> unit
         self.dependencies = {}  # output name -> input names
         self.error = None       # message of a bad input seen since the last step
@@ -167,20 +168,28 @@ class ArraySlave(Fmi2Slave):
                      description if i == 0 else None)
         return slice(first, first + n)
 
-    def add_motion(self, prefix, position, attitude, acceleration=False, who="reference point"):
-        """Motion inputs <prefix>position/attitude/velocity[/acceleration]; returns their slices."""
+    def add_motion(self, prefix, state, acceleration=False, who="reference point"):
+        """Motion inputs <prefix>position/attitude/velocity[/acceleration], starting at
+        ``state``'s (position, attitude, velocity: the body at t = 0); returns their slices."""
         In = Fmi2Causality.input
         slices = [
-            self.add_vector(f"{prefix}position", 3, In, "m", position, f"{who} position, global axes"),
-            self.add_vector(f"{prefix}attitude", 3, In, "rad", attitude,
+            self.add_vector(f"{prefix}position", 3, In, "m", state.position, f"{who} position, global axes"),
+            self.add_vector(f"{prefix}attitude", 3, In, "rad", state.attitude,
                             "roll, pitch, yaw; R = Rz(yaw) Ry(pitch) Rx(roll)"),
-            self.add_vector(f"{prefix}velocity", 6, In, LIN_ROT["velocity"], None,
+            self.add_vector(f"{prefix}velocity", 6, In, LIN_ROT["velocity"], state.velocity,
                             f"{who} velocity and angular velocity, global axes"),
         ]
         if acceleration:
-            slices.append(self.add_vector(f"{prefix}acceleration", 6, In, LIN_ROT["acceleration"], None,
-                                          f"{who} acceleration, global axes"))
+            slices.append(self.add_acceleration(f"{prefix}acceleration", f"{who} acceleration, global axes"))
         return slices
+
+    def add_acceleration(self, name, description):
+        """An acceleration input name[1..6]: its value at t = 0 follows from the loads at t = 0,
+        which in explicit mode depend on it, so the build cannot know it: start 0, listed in
+        ``unknown_start`` (the start-value check skips it)."""
+        s = self.add_vector(name, 6, Fmi2Causality.input, LIN_ROT["acceleration"], None, description)
+        self.unknown_start.update(f"{name}[{i}]" for i in range(1, 7))
+        return s
 
     def add_environment(self, uses_current):
         """current.speed/direction inputs (if used) and rho, g parameters."""
@@ -457,19 +466,18 @@ class LoadSlave(ArraySlave):
         self.loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in cfg.effects], explicit)
         Out, In = Fmi2Causality.output, Fmi2Causality.input
         own_acc = explicit and (self.loads.uses_acceleration or any(c.own for c in cfg.couplings))
-        self.motion_inputs = self.add_motion("", cfg.position, cfg.attitude, own_acc)
+        self.motion_inputs = self.add_motion("", cfg, own_acc)
         inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
         # hydrodynamic couplings: the source body's velocity (and acceleration) in
         self.couplings = []
         for c in cfg.couplings:
             src = c.source
             vel = self.motion_inputs[2] if c.own else self.add_vector(
-                f"{src}.velocity", 6, In, LIN_ROT["velocity"], None, f"velocity of coupled body {src}, global")
+                f"{src}.velocity", 6, In, LIN_ROT["velocity"], c.velocity, f"velocity of coupled body {src}, global")
             acc = None
             if explicit:
-                acc = self.motion_inputs[3] if c.own else self.add_vector(
-                    f"{src}.acceleration", 6, In, LIN_ROT["acceleration"], None,
-                    f"acceleration of coupled body {src}, global")
+                acc = self.motion_inputs[3] if c.own else self.add_acceleration(
+                    f"{src}.acceleration", f"acceleration of coupled body {src}, global")
             out = self.add_vector(f"{c.name}.force", 6, Out, LIN_ROT["force"], None,
                                   f"hydrodynamic coupling {c.name} (from {src}'s motion)")
             self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
@@ -576,10 +584,11 @@ class DynamicsSlave(ArraySlave):
         for b in cfg.bodies:
             p = f"{b.name}." if group else ""
             part = {"cfg": b}
-            part["loads"] = [self.add_vector(f"{p}{src}.force" if src else f"{p}force", 6, In, LIN_ROT["force"],
-                                             None, f"load from {src or 'the body FMU'}, global axes, "
-                                                   "about the reference point")
-                             for src in b.load_sources]
+            part["loads"] = [self.add_vector(p + b.load_input(src), 6, In, LIN_ROT["force"],
+                                             b.loads[k] if b.loads else None,
+                                             f"load from {src or 'the body FMU'}, global axes, "
+                                             "about the reference point")
+                             for k, src in enumerate(b.load_sources)]
             part["added"] = self.add_matrix(f"{p}added_mass", Par, b.added_mass,
                                             "mass contributions exported by load FMUs, global axes")
             part["position"] = self.add_vector(f"{p}position", 3, Out, "m", b.position)
@@ -694,8 +703,8 @@ class ConnectorSlave(ArraySlave):
         self.explicit = cfg.accel_mode == "explicit"
         Out = Fmi2Causality.output
         accel = self.explicit and self.joint.uses_acceleration
-        self.side_a = self.add_motion("A.", cfg.a.position, cfg.a.attitude, accel, "side A")
-        self.side_b = (self.add_motion("B.", cfg.b.position, cfg.b.attitude, False, "side B")
+        self.side_a = self.add_motion("A.", cfg.a, accel, "side A")
+        self.side_b = (self.add_motion("B.", cfg.b, False, "side B")
                        if cfg.b is not None else None)
         inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
         self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,

@@ -2,8 +2,9 @@
 scene's FMUs under ``resources/``.
 
 The SSD holds one component per FMU instance with the connectors the connections use
-(inputs and outputs, with their units) and every parameter, bound to the value the build
-gave it; the connections; the units (as SI base-unit exponents); and the default
+(inputs and outputs, with their units) and every parameter; each parameter and input is
+bound to its start value (the value the build gave it; an input's is its source's value at
+t = 0, fmi.starts); the connections; the units (as SI base-unit exponents); and the default
 experiment (start 0, the scene's stop time) with the communication step in libcosim's
 annotation (``osp:FixedStepAlgorithm``), since SSP 1.0 has no field for it.
 """
@@ -73,7 +74,7 @@ def system_structure(name: str, instances: dict, connections: list, stop: float,
             c = ET.SubElement(connectors, q(SSD, "Connector"), {"name": v.name, "kind": v.causality})
             ET.SubElement(c, q(SSC, "Real"), {"unit": v.unit} if v.unit else {})
             units.add(v.unit)
-            if v.causality == "parameter":
+            if v.causality in ("parameter", "input") and v.start is not None:
                 params.append(v)
         if params:
             values = ET.SubElement(ET.SubElement(ET.SubElement(comp, q(SSD, "ParameterBindings")),
