@@ -24,6 +24,27 @@ s.doStep(0.0, 0.05)
 """
 
 
+def open_fmus(folder, manifest):
+    """Every FMU of a built scene (its ``manifest``) on fmpy's FMU2Slave, instantiated and
+    initialised with no input set; returns ({instance: slave}, {instance: {variable: value
+    reference}}, {instance: {variable: declared start}})."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    fmus, vrs, starts = {}, {}, {}
+    for name, inst in manifest["instances"].items():
+        path = str(Path(folder) / inst["fmu"])
+        md = read_model_description(path)
+        s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName=name)
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        fmus[name], vrs[name] = s, {v.name: v.valueReference for v in md.modelVariables}
+        starts[name] = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
+    return fmus, vrs, starts
+
+
 def write_scene(folder, text, name="scene.toml"):
     path = Path(folder) / name
     path.parent.mkdir(parents=True, exist_ok=True)

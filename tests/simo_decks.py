@@ -19,3 +19,15 @@ def coupling_group(name, body_a, body_b, added_mass, kernels, timdel, length, te
 
 def write_deck(path, groups, header="SIMO hydrodynamic coupling data (SI units)"):
     return write_couplings(path, groups, header)
+
+
+def pair_deck(path, mass):
+    """SA, SB (self) and AB (cross) couplings of bodies a and b of ``mass`` [kg]: A∞ a
+    fraction of the mass, a few analytic kernels each (TIMDEL 0.1 s, 6 s long)."""
+    am = np.diag([0.2, 0.3, 0.5, 0.0, 0.0, 0.0]) * mass
+    cross = np.zeros((6, 6))
+    cross[0, 0], cross[1, 2] = 0.1 * mass, 0.05 * mass
+    return write_deck(path, [
+        coupling_group("SA", "a", "a", am, {(1, 1): (2e5, 0.8, 1.0), (2, 2): (1e5, 0.5, 0.6)}, 0.1, 6.0),
+        coupling_group("SB", "b", "b", am, {(3, 3): (3e5, 0.7, 0.9)}, 0.1, 6.0),
+        coupling_group("AB", "a", "b", cross, {(1, 1): (5e4, 0.6, 0.8), (2, 3): (-2e4, 0.9, 1.2)}, 0.1, 6.0)])

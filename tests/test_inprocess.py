@@ -8,7 +8,7 @@ from hydrofmu.cosim.master import RunError, run
 from hydrofmu.scene import load_scene
 
 from conftest import build, write_scene
-from simo_decks import coupling_group, write_deck
+from simo_decks import pair_deck
 
 M = 1.0e6
 
@@ -59,14 +59,7 @@ def scene_text(deck):
 @pytest.fixture(scope="module")
 def scene_and_build(tmp_path_factory):
     folder = tmp_path_factory.mktemp("inprocess")
-    am = np.diag([0.2, 0.3, 0.5, 0.0, 0.0, 0.0]) * M
-    cross = np.zeros((6, 6))
-    cross[0, 0], cross[1, 2] = 0.1 * M, 0.05 * M
-    deck = write_deck(folder / "pair.sim", [
-        coupling_group("SA", "a", "a", am, {(1, 1): (2e5, 0.8, 1.0), (2, 2): (1e5, 0.5, 0.6)}, 0.1, 6.0),
-        coupling_group("SB", "b", "b", am, {(3, 3): (3e5, 0.7, 0.9)}, 0.1, 6.0),
-        coupling_group("AB", "a", "b", cross, {(1, 1): (5e4, 0.6, 0.8), (2, 3): (-2e4, 0.9, 1.2)}, 0.1, 6.0)])
-    text = scene_text(deck.name)
+    text = scene_text(pair_deck(folder / "pair.sim", M).name)
     return load_scene(write_scene(folder, text)), build(folder, text)
 
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import MODELS
+from conftest import MODELS, open_fmus
 from hydrofmu.bench import native as native_timing
 from hydrofmu.bench.robust import ARENA_KB, FLAT_KB, growth
 
@@ -229,19 +229,7 @@ def test_ssp_runs_in_fmpy(name, scenes):
 def zero_start_jacobi(folder, manifest, steps, step):
     """Every connected output after each step, with every connected input 0 at the first
     step and each step's inputs the outputs of the step before (fmpy's SSP convention)."""
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-    fmus, vrs = {}, {}
-    for name, inst in manifest["instances"].items():
-        path = str(folder / inst["fmu"])
-        md = read_model_description(path)
-        s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName=name)
-        s.instantiate()
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-        s.exitInitializationMode()
-        fmus[name], vrs[name] = s, {v.name: v.valueReference for v in md.modelVariables}
+    fmus, vrs, _ = open_fmus(folder, manifest)
     conns = manifest["connections"]
     value = {(d, dv): 0.0 for _, _, d, dv in conns}
     out = {f"{s}.{sv}": [] for s, sv, _, _ in conns}

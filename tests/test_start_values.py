@@ -12,8 +12,8 @@ from hydrofmu import assembly
 from hydrofmu.cosim.master import run
 from hydrofmu.fmi.starts import StartValueError
 
-from conftest import build
-from simo_decks import coupling_group, write_deck
+from conftest import build, open_fmus
+from simo_decks import pair_deck
 
 M = 1.0e6
 STEPS = 40
@@ -73,29 +73,10 @@ def scene_text(deck, mode):
         """ for c, method in (("SA", "convolution"), ("SB", "state_space"), ("AB", "convolution")))
 
 
-def write_text(folder, mode):
-    am = np.diag([0.2, 0.3, 0.5, 0.0, 0.0, 0.0]) * M
-    cross = np.zeros((6, 6))
-    cross[0, 0], cross[1, 2] = 0.1 * M, 0.05 * M
-    deck = write_deck(folder / "pair.sim", [
-        coupling_group("SA", "a", "a", am, {(1, 1): (2e5, 0.8, 1.0), (2, 2): (1e5, 0.5, 0.6)}, 0.1, 6.0),
-        coupling_group("SB", "b", "b", am, {(3, 3): (3e5, 0.7, 0.9)}, 0.1, 6.0),
-        coupling_group("AB", "a", "b", cross, {(1, 1): (5e4, 0.6, 0.8), (2, 3): (-2e4, 0.9, 1.2)}, 0.1, 6.0)])
-    return scene_text(deck.name, mode)
-
-
 @pytest.fixture(scope="module", params=["export", "explicit"])
 def built(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp(f"starts_{request.param}")
-    return request.param, build(folder, write_text(folder, request.param))
-
-
-def declared_starts(fmu):
-    """{variable: start} of every variable with a start in the FMU's modelDescription.xml."""
-    with zipfile.ZipFile(fmu) as z:
-        root = ET.fromstring(z.read("modelDescription.xml"))
-    return {sv.get("name"): float(sv.find("Real").get("start")) for sv in root.iter("ScalarVariable")
-            if sv.find("Real") is not None and sv.find("Real").get("start") is not None}
+    return request.param, build(folder, scene_text(pair_deck(folder / "pair.sim", M).name, request.param))
 
 
 def step_first(folder, manifest, columns, steps, step):
@@ -103,24 +84,9 @@ def step_first(folder, manifest, columns, steps, step):
     connector starts at its input's start value in modelDescription.xml; at each step every
     FMU gets its connectors, steps, then every connected output is read (and the recorded
     columns sampled) and copied to its connectors.  Row 0: the outputs after initialization."""
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-    fmus, vrs, unzipped = {}, {}, []
-    value = {}
-    for name, inst in manifest["instances"].items():
-        path = str(folder / inst["fmu"])
-        md = read_model_description(path)
-        unzipped.append(extract(path))
-        s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped[-1], modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName=name)
-        s.instantiate()
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-        s.exitInitializationMode()
-        fmus[name], vrs[name] = s, {v.name: v.valueReference for v in md.modelVariables}
-        starts = declared_starts(path)
-        value.update({(name, dv): starts[dv] for _, _, d, dv in manifest["connections"] if d == name})
+    fmus, vrs, starts = open_fmus(folder, manifest)
     conns = manifest["connections"]
+    value = {(d, dv): starts[d][dv] for _, _, d, dv in conns}
     by_instance = {}
     for col in columns:
         name, var = col.split(".", 1)
@@ -190,7 +156,9 @@ def test_starts_are_the_state_at_t0(built):
     here: drag in a current, a stretched joint), the acceleration inputs 0."""
     mode, built = built
     manifest = json.loads((built / "manifest.json").read_text())
-    declared = {name: declared_starts(built / inst["fmu"]) for name, inst in manifest["instances"].items()}
+    from fmpy import read_model_description
+    declared = {name: {v.name: float(v.start) for v in read_model_description(str(built / inst["fmu"])).modelVariables
+                       if v.start is not None} for name, inst in manifest["instances"].items()}
     assert declared["a"]["velocity[2]"] == -0.2 and declared["a"]["b.velocity[2]"] == 0.5
     assert declared["link"]["B.velocity[1]"] == -0.2 and declared["link"]["A.attitude[3]"] == -0.1
     if mode == "explicit":
