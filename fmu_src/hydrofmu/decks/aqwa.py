@@ -33,9 +33,11 @@ of giving the six rows::
 
 The sections may come in any order and repeat. A section runs until the next line
 starting with ``*``. A whole AQWA input holds other ``*`` sections (geometry, mass,
-environment, …): they are skipped, as are lines before the first section; a ``*`` keyword
-that starts with ``Viscous`` but is neither of ours is an error (a misspelt section is
-not skipped silently).
+environment, …): they are skipped, as are lines before the first section.  Keywords and
+setting names are written in full, any case (decks/lines.py ``Grammar``, exact): a ``*``
+keyword that resembles ours (``*Viscous Drg``, ``*Viscous``, a word after it) is an error,
+not skipped; so is an unknown ``*`` section right after one of ours whose lines read as
+more of it (a stray line inside our section).
 Lines starting with ``#`` or ``!`` are comments. Names keep their spelling and inner
 blanks; two bodies (or two matrices) whose names differ only by case are duplicates.
 
@@ -50,11 +52,12 @@ import numpy as np
 
 from ..admissible import negative_diagonal
 from ..errors import InputError, InputWarning
-from .lines import fields, keyword_key, read_lines
+from .lines import Grammar, Reading, fields, interrupted, read_lines, with_reading
 
 OPTIONS = ("ABSOLUTE", "RELATIVE")
-_DRAG, _TABLE = keyword_key("Viscous Drag"), keyword_key("Viscous Drag Coefficients")
-_BODY, _TYPE, _OPTION, _REF, _NAME = (keyword_key(k) for k in
+DRAG, TABLE = "*Viscous Drag", "*Viscous Drag Coefficients"
+GRAMMAR = Grammar([DRAG, TABLE], stems=["*Viscous"], exact=True)
+_BODY, _TYPE, _OPTION, _REF, _NAME = (tuple(k.split()) for k in
                                       ("FLOATING BODY", "TYPE", "OPTION", "VISCOUS DRAG", "NAME"))
 
 
@@ -85,28 +88,44 @@ def read_viscous_drag(path):
     file, the line and the field on the first problem.
     """
     lines = read_lines(path, comment=("#", "!"))
+    reading = Reading(str(path), "AQWA")
     bodies, tables, refs = {}, {}, []  # refs: (body name, VISCOUS DRAG line)
     seen_drag = False
-    pos = 0
+    pos, previous = 0, None           # previous: (our section's name, its first line) just read
     while pos < len(lines):
         line = lines[pos]
-        section = _section(line)
+        key = GRAMMAR.find(line) if line.text.startswith("*") else None
         end = pos + 1
         while end < len(lines) and not lines[end].text.startswith("*"):
             end += 1
         block = lines[pos + 1:end]
-        if section is None:
-            pos = end          # another section of the AQWA input (or lines before the first): skipped
+        if key is None:
+            # another section of the AQWA input (or lines before the first): skipped, unless
+            # it reads as more of the section it follows
+            if previous is not None and block:
+                read = _read_bodies if previous[0] == DRAG else _read_tables
+                interrupted(line, f"the {previous[0]} section at line {previous[1]}",
+                            lambda: read(block, lines, end, {}, []) or True)
+            reading.skip(line, count=end - pos)
+            previous = None
+            pos = end
             continue
-        if section == _DRAG:
+        if key.spelling == DRAG:
             seen_drag = True
             if not block:
                 raise line.error("FLOATING BODY", "*Viscous Drag has no FLOATING BODY block")
+            before = len(bodies)
             _read_bodies(block, lines, end, bodies, refs)
+            for b in list(bodies.values())[before:]:
+                reading.use(f"{DRAG}: FLOATING BODY={b.name}", b.line)
         else:
             if not block:
                 raise line.error("NAME", "*Viscous Drag Coefficients has no NAME block")
+            before = len(tables)
             _read_tables(block, lines, end, tables)
+            for name, _, number in list(tables.values())[before:]:
+                reading.use(f"{TABLE}: NAME={name}", number)
+        previous = (key.spelling, line.number)
         pos = end
     if not seen_drag:
         raise InputError(path, None, "*Viscous Drag", "no *Viscous Drag keyword in the file")
@@ -118,18 +137,7 @@ def read_viscous_drag(path):
             raise ref_line.error("VISCOUS DRAG", f"no matrix named {ref!r} under *Viscous Drag "
                                                  f"Coefficients (defined: {known})")
         bodies[name.upper()].matrix = tables[key][1].copy()
-    return {d.name: d for d in bodies.values()}
-
-
-def _section(line):
-    """_DRAG, _TABLE, or None when ``line`` is not one of our keyword lines."""
-    if not line.text.startswith("*"):
-        return None
-    key = keyword_key(line.text[1:])
-    if key not in (_DRAG, _TABLE) and key[:1] == _DRAG[:1]:
-        raise line.error("*Viscous Drag", f"expected a *Viscous Drag or *Viscous Drag Coefficients "
-                                          f"keyword line, found {line.text!r}")
-    return key if key in (_DRAG, _TABLE) else None
+    return with_reading({d.name: d for d in bodies.values()}, reading)
 
 
 def _pair(line):
@@ -137,7 +145,7 @@ def _pair(line):
     if "=" not in line.text:
         return None, None
     key, value = line.text.split("=", 1)
-    return keyword_key(key), value.strip()
+    return tuple(key.upper().split()), value.strip()
 
 
 def _read_bodies(block, lines, end, bodies, refs):

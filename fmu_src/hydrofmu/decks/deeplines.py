@@ -11,7 +11,11 @@ Numbers are separated by blanks (commas are tolerated). The rows run until the n
 starting with ``*`` or the end of the file; other ``*`` keywords (the rest of a DeepLines
 model) are skipped. Several ``*CURRENTPOL`` blocks may follow each other, one per
 structure. Lines starting with ``!`` or ``#`` are comments. The keyword and ``NAME`` are
-case-insensitive and may have blanks around ``=`` and ``,``.
+case-insensitive and may have blanks around ``=`` and ``,``.  Keywords are written in full
+(decks/lines.py ``Grammar``, exact): a ``*`` keyword that resembles ours (``*CURRENTPL``,
+``*CURRENTPOLE``, ``*CURRENTS``) is an error, not skipped; so is an unknown keyword right after
+a ``*CURRENTPOL`` block whose lines read as more of its rows (4 numbers, the angles going on).
+The table has no count: every row up to the next keyword is read.
 
 Checks: NAME given, at most 8 characters, no blanks, not repeated (case-insensitive);
 first line exactly 4 numbers with SURFC > 0; each row exactly 4 numbers; at least 2 rows;
@@ -27,10 +31,34 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .lines import Line, check_profile, convert, fields, read_lines
+from .lines import Grammar, Line, Reading, check_profile, convert, fields, interrupted, read_lines, with_reading
 
 KEYWORD = "*CURRENTPOL"
 ROW = ("ANGC", "CXC", "CYC", "CMZC")
+CURRENT, CURPROF = "*CURRENT", "*CURPROF"
+
+
+def _keyword(line):
+    """The keyword of a ``*`` line, blanks and what follows a comma or a blank left out."""
+    text = line.text.split(",")[0].strip()
+    return [text.split()[0]] if text.startswith("*") and text.split() else []
+
+
+GRAMMAR = Grammar([KEYWORD, CURRENT, CURPROF], exact=True, words=_keyword)
+
+
+def _blocks(lines, reading):
+    """(keyword line, its Keyword or None, its data lines) of each ``*`` block; the unknown
+    ones (and lines before the first keyword) recorded as skipped."""
+    out, pos = [], 0
+    while pos < len(lines):
+        end = pos + 1
+        while end < len(lines) and not lines[end].text.startswith("*"):
+            end += 1
+        key = GRAMMAR.find(lines[pos])
+        out.append((lines[pos], key, lines[pos + 1:end]))
+        pos = end
+    return out
 
 
 @dataclass
@@ -61,30 +89,42 @@ def read_current_polars(path):
     Raises InputError naming the file, the line and the field on the first problem.
     """
     lines = read_lines(path, comment=("!", "#"))
-    out = {}
-    pos = 0
-    while pos < len(lines):
-        line = lines[pos]
-        end = pos + 1
-        while end < len(lines) and not lines[end].text.startswith("*"):
-            end += 1
-        if _is_currentpol(line):
-            data = _read_block(line, lines[pos + 1:end])
-            key = data.name.upper()
-            if key in out:
+    reading = Reading(str(path), "DeepLines")
+    out, previous = {}, None
+    for line, key, block in _blocks(lines, reading):
+        if key is not None and key.spelling == KEYWORD:
+            _is_currentpol(line)
+            data = _read_block(line, block)
+            k = data.name.upper()
+            if k in out:
                 raise line.error("NAME", f"structure {data.name!r} already has a *CURRENTPOL "
-                                         f"at line {out[key].line}")
-            out[key] = data
-        pos = end
+                                         f"at line {out[k].line}")
+            out[k] = previous = data
+            reading.use(f"{KEYWORD},NAME={data.name}", line)
+            continue
+        if key is None and previous is not None and block:
+            interrupted(line, f"*CURRENTPOL,NAME={previous.name} (line {previous.line})",
+                        lambda: _more_rows(previous, block))
+        reading.skip(line, count=len(block) + 1)
+        previous = None
     if not out:
         raise InputError(path, None, KEYWORD, "no *CURRENTPOL keyword in the file")
-    return {d.name: d for d in out.values()}
+    return with_reading({d.name: d for d in out.values()}, reading)
+
+
+def _more_rows(data, block):
+    """True when every line of ``block`` is a row ANGC CXC CYC CMZC going on from the table."""
+    last = data.angles[-1]
+    for row in block:
+        angle = fields(row, list(ROW))["ANGC"]
+        if not last < angle <= 360.0:
+            return False
+        last = angle
+    return True
 
 
 def _is_currentpol(line):
     text = line.text.replace(" ", "").upper()
-    if not text.startswith(KEYWORD):
-        return False
     if text != KEYWORD and not text.startswith(KEYWORD + ","):  # e.g. '*CURRENTPOL NAME=X'
         raise line.error("NAME", f"expected *CURRENTPOL,NAME=structure, found {line.text!r}")
     return True
@@ -147,7 +187,6 @@ def _name(head):
 
 
 # --- current profile: *CURRENT and *CURPROF ---------------------------------------------
-CURRENT, CURPROF = "*CURRENT", "*CURPROF"
 
 
 def read_current_profile(path):
@@ -172,17 +211,17 @@ def read_current_profile(path):
     Raises InputError naming file, line and field (a level above the surface, levels not
     ordered, a missing or extra value, *CURPROF after *CURRENT, several times)."""
     lines = read_lines(path, comment=("!", "#"), continuation="&")
+    reading = Reading(str(path), "DeepLines current")
     blocks = {}
-    for pos, line in enumerate(lines):
-        if not line.text.startswith("*"):
-            continue
-        key = line.text.split()[0].replace(" ", "").upper().split(",")[0]
+    for line, found, block in _blocks(lines, reading):
+        key = found.spelling if found is not None else None
         if key not in (CURRENT, CURPROF):
+            reading.skip(line, count=len(block) + 1)
             continue
         if key in blocks:
             raise line.error(key, f"{key} given twice (first at line {blocks[key][0].number})")
-        end = next((k for k in range(pos + 1, len(lines)) if lines[k].text.startswith("*")), len(lines))
-        blocks[key] = (line, _data(line, lines[pos + 1:end]))
+        blocks[key] = (line, _data(line, block))
+        reading.use(key, line)
     if CURRENT not in blocks:
         raise InputError(path, None, CURRENT, "no *CURRENT keyword in the file")
     head, rows = blocks[CURRENT]
@@ -220,7 +259,7 @@ def read_current_profile(path):
         where.append(({"z": at_z, "speed": row.at_word(2 + 2 * j), "direction": row.at_word(1 + 2 * j)},
                       {"z": f"ZCUR({j + 1})" if CURPROF in blocks else "TCUR(1)",
                        "speed": names[2 + 2 * j], "direction": names[1 + 2 * j]}))
-    return check_profile(out, where)
+    return with_reading(check_profile(out, where, reading), reading)
 
 
 def _data(head, body):

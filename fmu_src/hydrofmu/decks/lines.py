@@ -2,10 +2,14 @@
 typed fields with errors that name the file, the line and the field.
 
 FREAD, the free-format reader of SIMO and RIFLEX input (``fread_lines``, ``fields``,
-``is_keyword``), as the readers apply it:
+``Keyword``), as the readers apply it:
 
-- a data group starts with an identifier of up to three words; only the first four letters
-  of each word count, case does not (``HYDRodynamic COUPling DATA`` = ``hydr coup data``);
+- a data group starts with an identifier of up to three words, printed in the manuals with
+  capitals and lower-case letters: the capitals of each word must be written, the lower-case
+  letters may be (``UNIT NAMe SPECification`` = ``UNIT NAM SPEC`` = ``unit names
+  specification``; ``UNIT NA SPEC`` is an error), case does not count; letters written beyond
+  the capitals must spell the word (a longer word, such as a plural, may follow it in full);
+  no extra words;
 - values are separated by blanks (tabs) and/or commas; a number may carry a Fortran ``D``
   exponent (``2.5D+03``);
 - ``/`` in place of a value gives that field its default (``fields(..., defaults=)``);
@@ -13,13 +17,20 @@ FREAD, the free-format reader of SIMO and RIFLEX input (``fread_lines``, ``field
 - ``'`` starts a comment: a line whose first non-blank character is ``'`` is skipped, and
   text after a ``'`` on a data line is ignored;
 - ``END`` ends the input: whatever follows it is not read.
+
+Strict inside a group, lenient only between groups (``Grammar``): a line that resembles a
+keyword a reader knows (too short, misspelt, extra words, a known stem) is an error naming
+the keyword, never a skipped group; a sub-group outside its group, or a group that may be
+given once given twice, is an error; the line after a group must start a new one.  What a
+reader used and skipped, and its warnings, is kept in a ``Reading``.
 """
 import math
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..admissible import finite_problem
-from ..errors import InputError
+from ..errors import InputError, InputWarning
 from ..textfile import read_text
 
 
@@ -107,19 +118,214 @@ def fread_lines(path):
 
 def is_end(line):
     """True for the FREAD ``END`` line that ends the input."""
-    return keyword_key(line.text) == (END,)
+    return END_KEY.matches(line.words)
 
 
-def keyword_key(text):
-    """Normalised keyword: the first four letters of each word, upper case.
-    'NEW COMPonent BODY' and 'new comp body' both give ('NEW', 'COMP', 'BODY')."""
-    return tuple(word[:4].upper() for word in text.split())
+class Keyword:
+    """A keyword as a manual prints it, and the rule that matches it.
+
+    FREAD (``exact=False``): each word's leading capitals must be written, its lower-case
+    letters may be, letters written beyond the capitals must spell the word (a longer word,
+    e.g. a plural, may follow the whole word), case does not count, the word count must be
+    the keyword's.  ``exact=True`` (DeepLines, AQWA): every word in full, any case.
+    """
+
+    def __init__(self, spelling, exact=False):
+        self.spelling, self.exact = spelling, exact
+        self.words = tuple((w.upper() if exact else w[:_caps(w)].upper(), w.upper()) for w in spelling.split())
+
+    def __repr__(self):
+        return self.spelling
+
+    def _word(self, k, word):
+        """'match', 'near' (too short, misspelt, letters beyond an exact word) or None."""
+        caps, full = self.words[k]
+        w = word.upper()
+        if self.exact:
+            if w == full:
+                return "match"
+            return "near" if w.startswith(full) or full.startswith(w) or _osa(w, full) <= 1 else None
+        rest, more = w[len(caps):], full[len(caps):]
+        if w.startswith(caps) and (not rest or rest.isalpha()) and (rest.startswith(more) or more.startswith(rest)):
+            return "match"
+        if caps.startswith(w) or (w[:1] == full[:1] and len(w) >= 3 and min(
+                (_osa(w, full[:n]) for n in range(max(len(caps), len(w) - 1), min(len(full), len(w) + 1) + 1)),
+                default=2) <= 1):
+            return "near"
+        return None
+
+    def matches(self, words):
+        return len(words) == len(self.words) and all(self._word(k, w) == "match" for k, w in enumerate(words))
+
+    def resembles(self, words):
+        """Why ``words`` look like this keyword without matching it, or None."""
+        n = len(self.words)
+        kinds = [self._word(k, w) for k, w in enumerate(words[:n])]
+        if len(words) == n and None not in kinds and "near" in kinds and (n == 1 or "match" in kinds):
+            return "abbreviated below its capitals or misspelt" if not self.exact else "misspelt"
+        if len(words) > n and all(k == "match" for k in kinds):
+            return f"extra words after the keyword ({' '.join(words[n:])!r})"
+        if 2 <= len(words) < n and all(k == "match" for k in kinds):
+            return "incomplete"
+        return None
+
+
+def _caps(word):
+    """Length of a keyword word's leading capitals (all of it when it has no lower case)."""
+    return next((i for i, c in enumerate(word) if c.islower()), len(word))
+
+
+def _osa(a, b):
+    """Edit distance with adjacent transpositions (optimal string alignment)."""
+    d = [[i + j if i * j == 0 else 0 for j in range(len(b) + 1)] for i in range(len(a) + 1)]
+    for i in range(1, len(a) + 1):
+        for j in range(1, len(b) + 1):
+            d[i][j] = min(d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1]))
+            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
+                d[i][j] = min(d[i][j], d[i - 2][j - 2] + 1)
+    return d[-1][-1]
+
+
+END_KEY = Keyword(END)
 
 
 def is_keyword(line, keyword):
-    """True if ``line`` is the keyword line ``keyword`` (first four letters of each word
-    count, case does not; extra words on the line are not allowed)."""
-    return keyword_key(line.text) == keyword_key(keyword)
+    """True if ``line`` is the keyword line ``keyword`` (a spelling or a Keyword)."""
+    key = keyword if isinstance(keyword, Keyword) else Keyword(keyword)
+    return key.matches(line.words)
+
+
+class Grammar:
+    """The keywords a reader knows: ``groups`` (top-level data groups), ``inner`` (sub-groups,
+    legal only inside their group), ``once`` (groups a file may hold once) and ``stems``
+    (starts that only our groups have: a line starting so is ours or an error).
+
+    ``find(line)`` gives the keyword a line is, None for a line that starts like no keyword
+    we read, and raises InputError (file, line, the keyword it resembles) otherwise."""
+
+    def __init__(self, groups, inner=(), once=(), stems=(), exact=False, words=None):
+        self.exact = exact
+        self.groups = [Keyword(k, exact) for k in groups]
+        self.inner = [Keyword(k, exact) for k in inner]
+        self.once = {k.spelling for k in self.groups if k.spelling in once}
+        self.stems = [Keyword(k, exact) for k in stems]
+        self.words = words or (lambda line: line.words)
+
+    def find(self, line, field_=None):
+        """``field_``: the field an error names (default: "data group" for FREAD, the
+        keyword itself for exact keywords)."""
+        words = self.words(line)
+        if not words:
+            return None
+        for key in self.groups + self.inner:
+            if key.matches(words):
+                return key
+        for key in self.groups + self.inner:
+            why = key.resembles(words)
+            if why:
+                raise line.error(field_ or ("data group" if not self.exact else key.spelling),
+                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is "
+                                               f"not it ({why}); write it as the manual prints it (capitals required)"
+                                 if not self.exact else
+                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is not it ({why})")
+        for stem in self.stems:
+            n = len(stem.words)
+            if len(words) >= n and all(stem._word(k, w) == "match" for k, w in enumerate(words[:n])):
+                known = " or ".join(repr(k.spelling) for k in self.groups + self.inner
+                                    if k.words[:n] == stem.words)
+                raise line.error(field_ or ("data group" if not self.exact else self.groups[0].spelling),
+                                 f"expected {known}, found {line.text!r}")
+        return None
+
+    def expect(self, line, *keys):
+        """``line`` must be one of ``keys``: the Keyword it is, or an error naming them."""
+        found = self.find(line, keys[0])
+        if found is None or found.spelling not in keys:
+            raise line.error(keys[0], f"expected {' or '.join(map(repr, keys))}, found {line.text!r}")
+        return found
+
+
+@dataclass
+class Reading:
+    """What a reader did with a file: the groups it ``used`` and the ones it ``skipped``
+    (each (name, line)), and the ``warnings`` it gave (suspicious but legal data)."""
+    path: str
+    reader: str
+    used: list = field(default_factory=list)
+    skipped: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+    _next: int = None
+
+    def use(self, name, line):
+        self.used.append((str(name), line.number if isinstance(line, Line) else line))
+
+    def skip(self, line, pos=None, count=1):
+        """``count`` lines skipped from ``line`` on; ``pos``: the index of a single line among
+        the data lines, to make consecutive skipped lines one span named by its first line."""
+        if pos is not None and self.skipped and self._next == pos:
+            name, number, n = self.skipped[-1]
+            self.skipped[-1] = (name, number, n + count)
+        else:
+            self.skipped.append((line.text, line.number, count))
+        self._next = None if pos is None else pos + count
+
+    def warn(self, line, field_, message):
+        """A warning for suspicious but legal data (printed by the CLI, kept for the manifest)."""
+        w = InputWarning(self.path, line.number if line is not None else None, field_, message)
+        self.warnings.append(str(w))
+        warnings.warn(w)
+
+    def as_dict(self):
+        return {"path": self.path, "reader": self.reader,
+                "used": [{"group": n, "line": k} for n, k in self.used],
+                "skipped": [{"group": n, "line": k, "lines": c} for n, k, c in self.skipped],
+                "warnings": list(self.warnings)}
+
+    def summary(self):
+        """Lines for the build output: what was used and skipped, by name and line."""
+        used = ", ".join(f"{n} (line {k})" for n, k in self.used) or "nothing"
+        skipped = ", ".join(f"{n!r} (line {k}{f', {c} lines' if c > 1 else ''})"
+                            for n, k, c in self.skipped) or "nothing"
+        return [f"deck {self.path} ({self.reader}): used {used}", f"  skipped {skipped}"]
+
+
+class Entries(dict):
+    """A reader's result (name → data) with its ``reading``."""
+    reading = None
+
+
+class Rows(list):
+    """A reader's profile rows with its ``reading``."""
+    reading = None
+
+
+def with_reading(result, reading):
+    out = (Entries if isinstance(result, dict) else Rows)(result)
+    out.reading = reading
+    return out
+
+
+def after_group(cur, starts_group, owner, expected="a new data group"):
+    """The line after a group's last line must end the input or start a new group: a data
+    line there (a count exceeded, a row too many) is an error, never skipped."""
+    nxt = cur.peek()
+    if nxt is not None and not is_end(nxt) and not starts_group(nxt):
+        raise nxt.error("data group identifier", f"unexpected line {nxt.text!r} after {owner}: the layout has no further "
+                                      f"line here (a count exceeded or a row too many?); expected {expected}")
+
+
+def interrupted(unknown, owner, rest):
+    """An unknown group that ends one of ours where its layout allows, but whose lines read
+    as more of ours (``rest()`` parses them without error), is a stray line inside our group:
+    an error, not a skipped group."""
+    try:
+        ok = rest()
+    except InputError:
+        return
+    if ok:
+        raise unknown.error("data group", f"{unknown.text!r} starts no group hydrofmu reads, but the lines after it "
+                                          f"read as more of {owner}: a stray line inside that group? "
+                                          f"(remove it, or move the group it starts)")
 
 
 def fields(line, names, kind=float, defaults=None, slash=None):
@@ -208,15 +414,20 @@ class Cursor:
         return line
 
 
-def check_profile(rows, where):
+def check_profile(rows, where, reading=None):
     """Check current profile rows [[z, speed, direction], ...] read from a file
     (physics.current.profile_problem); ``where[k]`` = (line, {"z": field, "speed": field,
     "direction": field}) names the first problem's line and field; ``line`` may be a dict
-    of lines by the same keys when a level's values sit on different lines."""
+    of lines by the same keys when a level's values sit on different lines.  A direction
+    outside [0°, 360°] (370° for 10°?) is legal but said: a warning in ``reading``."""
     from ..physics.current import profile_problem
     problem = profile_problem(*zip(*rows))
+    at = (lambda k, name: (where[k][0][name] if isinstance(where[k][0], dict) else where[k][0]))
     if problem is not None:
         k, name, message = problem
-        line, names = where[k]
-        raise (line[name] if isinstance(line, dict) else line).error(names[name], message)
+        raise at(k, name).error(where[k][1][name], message)
+    for k, row in enumerate(rows):
+        if reading is not None and not 0.0 <= row[2] <= 360.0:
+            reading.warn(at(k, "direction"), where[k][1]["direction"],
+                         f"direction {row[2]:g}° is outside 0…360° (read as {row[2] % 360.0:g}°): a typing slip?")
     return rows

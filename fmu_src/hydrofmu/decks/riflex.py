@@ -1,8 +1,8 @@
 """RIFLEX input: the BODY and CONB component data groups, and the current states of the
 environments (``read_current_states``, layout at its definition below).
 
-Layout, one data group per component (keywords: first four letters of each word, any
-case; lines starting with ' are comments; commas separate like blanks)::
+Layout, one data group per component (keywords by their capitals, any case, decks/lines.py;
+lines starting with ' are comments; commas separate like blanks)::
 
     NEW COMPonent BODY              NEW COMPonent CONB
     CMPTYP-ID                       CMPTYP-ID
@@ -20,17 +20,22 @@ AMZ the value 0 (no default printed: the term is absent); ICOO and CMPTYP-ID hav
 ``&`` continues a line, ``'`` starts a comment, ``END`` ends the input.
 
 Whole INPMOD files: every other data group, and lines before the first group, are
-skipped.  A line starts a data group when it is a NEW line or all its words begin with a
-letter (RIFLEX groups such as ``END`` or ``UNIT NAMES SPECIFICATION``): such a line ends
-the CONB group without its IRX line; any other line left after a BODY or CONB group is an
-error.
+skipped (strict inside our groups, lenient only between groups: decks/lines.py ``Grammar``).
+A line starts a data group when it is a NEW line or all its words begin with a letter
+(RIFLEX groups such as ``END`` or ``UNIT NAMES SPECIFICATION``): such a line ends the CONB
+group without its IRX line; any other line left after one of our groups is an error (a
+level beyond NCULEV, a fourth CONB line).  A line that resembles one of our keywords
+(``UNIT NA SPEC``, ``NEW COMP BOD``, words after it) is an error, as is a second ``UNIT NAMe
+SPECification`` and an unknown group right after a CONB whose first line reads as its
+IRX IRY IRZ line (a stray line inside the CONB group).
 """
 from dataclasses import dataclass, replace
 
 from ..errors import InputError
 from ..physics.lumped import LumpedBody, coordinate_code
 from . import units as unit_systems
-from .lines import Cursor, check_profile, fields, fread_lines, is_end, is_keyword, keyword_key
+from .lines import (Cursor, Grammar, Reading, after_group, check_profile, fields, fread_lines, interrupted, is_end,
+                    with_reading)
 
 HYDRO = ("ICOO", "CDX", "CDY", "CDZ", "AMX", "AMY", "AMZ")
 FREEDOM = ("IRX", "IRY", "IRZ")
@@ -73,35 +78,54 @@ class ConbData(_Lumped):
 def starts_group(line):
     """True if ``line`` opens a data group: a NEW line or one of words that all begin with a letter."""
     words = line.words
-    return keyword_key(line.text)[:1] == ("NEW",) or all(w[0].isalpha() for w in words)
+    return words[0].upper() == "NEW" or all(w[0].isalpha() for w in words)
+
+
+def _groups(path, reader, read):
+    """The FREAD group loop shared by the component and current readers: every line between
+    groups is looked up in GRAMMAR (a near miss is an error), our groups are handed to
+    ``read(cur, line, key)``, the rest skipped; the unit declaration is read once."""
+    cur = Cursor(fread_lines(path), path)
+    reading = Reading(str(path), reader)
+    system, first = None, None
+    while not cur.done():
+        pos = cur.pos
+        line = cur.next("data group")
+        if is_end(line):
+            break
+        key = GRAMMAR.find(line)
+        if key is not None and key.spelling == UNITS:
+            if first is not None:
+                raise line.error(UNITS, f"{UNITS!r} given twice (first at line {first}): a file declares its "
+                                        f"units once")
+            system, first = _units(cur), line.number
+            reading.use(UNITS, line)
+        elif key is None or not read(cur, line, key.spelling, reading):
+            reading.skip(line, pos)
+    return system, reading
 
 
 def read_components(path, units="SI"):
-    """All BODY and CONB components of a RIFLEX file: dict CMPTYP-ID → BodyData | ConbData.
+    """All BODY and CONB components of a RIFLEX file: dict CMPTYP-ID → BodyData | ConbData
+    (with ``.reading``, decks/lines.py).
     ``units``: the file's unit system (decks/units.py); values come back in SI."""
-    cur = Cursor(fread_lines(path), path)
-    out, system = {}, None
-    while not cur.done():
-        line = cur.next("NEW")
-        if is_end(line):
-            break
-        if is_keyword(line, UNITS):
-            system = _units(cur)
-            continue
-        kind = next((k for k, key in GROUPS.items() if is_keyword(line, key)), None)
+    out = {}
+
+    def read(cur, line, name, reading):
+        kind = next((k for k, key in GROUPS.items() if key == name), None)
         if kind is None:
-            continue  # another data group or its data
+            return False
         comp = _read_group(cur, line, kind, out)
         out[comp.name] = comp
-        extra = cur.peek()
-        if extra is not None and not starts_group(extra):
-            raise extra.error("data group identifier",
-                              f"unexpected line {extra.text!r} after {kind} {comp.name!r}; "
-                              "expected a new data group (NEW ...) or the end of the file")
+        reading.use(f"{GROUPS[kind]} {comp.name}", line)
+        after_group(cur, starts_group, f"{kind} {comp.name!r}", "a new data group (NEW ...) or the end of the file")
+        return True
+    system, reading = _groups(path, "RIFLEX", read)
     unit_systems.check(system, units, path)
     mass, force = unit_systems.factors(units)
-    return {k: replace(c, am=c.am * mass, cd=tuple(x * force for x in c.cd),
-                       added_mass=tuple(x * mass for x in c.added_mass)) for k, c in out.items()}
+    return with_reading({k: replace(c, am=c.am * mass, cd=tuple(x * force for x in c.cd),
+                                    added_mass=tuple(x * mass for x in c.added_mass)) for k, c in out.items()},
+                        reading)
 
 
 def _units(cur):
@@ -131,7 +155,7 @@ def _read_group(cur, head, kind, seen):
     if cur.done():
         raise InputError(cur.path, head.number, "CMPTYP-ID", f"unexpected end of file: missing CMPTYP-ID of {owner}")
     line = cur.next("CMPTYP-ID")
-    if keyword_key(line.text)[:1] == ("NEW",) or len(line.words) != 1:
+    if line.words[0].upper() == "NEW" or len(line.words) != 1:
         raise line.error("CMPTYP-ID", f"expected one component identifier, found {line.text!r}")
     name = line.words[0]
     if len(name) > 8:
@@ -160,13 +184,20 @@ def _read_group(cur, head, kind, seen):
     codes = (0, 0, 0)
     nxt = cur.peek()
     if nxt is not None and not starts_group(nxt):
-        line = cur.next("IRX")
-        values = fields(line, list(FREEDOM), kind=int, defaults=dict.fromkeys(FREEDOM, 0))
-        for key in FREEDOM:
-            if values[key] not in (0, 1):
-                raise line.error(key, f"expected 0 (free) or 1 (fixed), found {values[key]}")
-        codes = tuple(values[k] for k in FREEDOM)
+        codes = _codes(cur.next("IRX"))
+    elif nxt is not None and not is_end(nxt) and GRAMMAR.find(nxt) is None and cur.pos + 1 < len(cur.lines):
+        after = cur.lines[cur.pos + 1]      # an unknown group after the CONB: is its first line our IRX line?
+        interrupted(nxt, f"CONB {name!r} (its IRX IRY IRZ line)", lambda: not starts_group(after) and _codes(after))
     return ConbData(**common, codes=codes)
+
+
+def _codes(line):
+    """CONB's ``IRX IRY IRZ`` line (each 0 free or 1 fixed, default 0)."""
+    values = fields(line, list(FREEDOM), kind=int, defaults=dict.fromkeys(FREEDOM, 0))
+    for key in FREEDOM:
+        if values[key] not in (0, 1):
+            raise line.error(key, f"expected 0 (free) or 1 (fixed), found {values[key]}")
+    return tuple(values[k] for k in FREEDOM)
 
 
 # --- current profiles: environment data (INPMOD data group D) ------------------------------
@@ -185,6 +216,7 @@ ENVIRONMENT = "ENVIronment IDENtification"
 WATER = "WATErdepth AND WAVEtype"
 CURRENT_STATE = "NEW CURRENT STATE"
 CURRENT_LINE = "NEW CURRENT LINE"
+GRAMMAR = Grammar([UNITS, *GROUPS.values(), ENVIRONMENT, WATER, CURRENT_STATE, CURRENT_LINE], once=[UNITS])
 
 
 @dataclass(frozen=True)
@@ -207,31 +239,44 @@ def read_current_states(path, units=None):
     hydrofmu reads (decks/units.py checks UL = m and UT = s), so no value is scaled.
     Raises InputError naming file, line and field (a level above the surface, levels not in
     decreasing z, a missing value, a state out of order, …)."""
-    cur = Cursor(fread_lines(path), path)
-    out, env, ncusta, system = {}, None, None, None
-    while not cur.done():
-        line = cur.next("data group")
-        if is_end(line):
-            break
-        if is_keyword(line, UNITS):
-            system = _units(cur)
-        elif is_keyword(line, ENVIRONMENT):
-            env, ncusta = _environment(cur, line, out), None
-            out[env] = {}
-        elif is_keyword(line, WATER):
+    out, env = {}, {}           # env: the environment being read: name, NCUSTA, WATER's line
+
+    def read(cur, line, name, reading):
+        if name == ENVIRONMENT:
+            env.clear()
+            env["name"] = _environment(cur, line, out)
+            out[env["name"]] = {}
+            reading.use(f"{ENVIRONMENT} {env['name']}", line)
+        elif name == WATER:
+            if not env:
+                raise line.error(WATER, f"{WATER!r} before any {ENVIRONMENT!r}")
+            if "water" in env:
+                raise line.error(WATER, f"{WATER!r} given twice in environment {env['name']!r} (first at line "
+                                        f"{env['water']})")
             names = ("WDEPTH", "NOIRW", "NORW", "NCUSTA", "NWISTA")
             values = fields(_next_data(cur, names, WATER), list(names), kind=[float, int, int, int, int],
                             defaults={"NWISTA": 0})
-            ncusta = values["NCUSTA"]
-        elif is_keyword(line, CURRENT_STATE):
-            if env is None:
+            env["ncusta"], env["water"] = values["NCUSTA"], line.number
+            reading.use(f"{WATER} of {env['name']}", line)
+        elif name == CURRENT_STATE:
+            if not env:
                 raise line.error("IDENV", f"{CURRENT_STATE!r} before any {ENVIRONMENT!r}: a current belongs "
                                           f"to an environment")
-            state = _current_state(cur, env, out[env], ncusta)
-            out[env][state.number] = state
+            if "water" not in env:
+                raise line.error(CURRENT_STATE, f"{CURRENT_STATE!r} before {WATER!r} of environment "
+                                                f"{env['name']!r}: the manual's order is WATErdepth first")
+            state = _current_state(cur, env["name"], out[env["name"]], env["ncusta"], reading)
+            out[env["name"]][state.number] = state
+            reading.use(f"{CURRENT_STATE} {env['name']}/{state.number}", line)
+            after_group(cur, starts_group, f"current state {state.number} of {env['name']!r} "
+                                           f"(NCULEV = {len(state.rows)} levels)")
+        else:
+            return False
+        return True
+    system, reading = _groups(path, "RIFLEX current", read)
     if units is not None:
         unit_systems.check(system, units, path, key="current_units")
-    return out
+    return with_reading(out, reading)
 
 
 def _environment(cur, head, seen):
@@ -240,7 +285,7 @@ def _environment(cur, head, seen):
     right after, which tells a blank text line from a given one."""
     ident = cur.next("IDENV")              # the text line, or IDENV when the text line was blank
     nxt = cur.peek()
-    if nxt is not None and not is_end(nxt) and not is_keyword(nxt, WATER):
+    if nxt is not None and not is_end(nxt) and GRAMMAR.find(nxt) is not GRAMMAR.groups[4]:
         ident = cur.next("IDENV")
     if len(ident.words) != 1:
         raise ident.error("IDENV", f"expected one environment identifier after the text line of "
@@ -252,7 +297,7 @@ def _environment(cur, head, seen):
     return name
 
 
-def _current_state(cur, env, states, ncusta):
+def _current_state(cur, env, states, ncusta, reading=None):
     names = ("ICUSTA", "NCULEV", "L_EXT")
     dim = _next_data(cur, names, CURRENT_STATE)
     v = fields(dim, list(names), kind=int, defaults={"L_EXT": 0})
@@ -284,5 +329,5 @@ def _current_state(cur, env, states, ncusta):
                                        f"{f[level[0]]:g} follows z = {rows[-1][0]:g}")
         rows.append([f[level[0]], f[level[2]], f[level[1]]])
         where.append((line, dict(zip(("z", "direction", "speed"), level))))
-    check_profile(rows, where)
+    check_profile(rows, where, reading)
     return CurrentState(env, number, rows, str(cur.path), dim.number)

@@ -1,6 +1,6 @@
 """SIMO hydrodynamic coupling between bodies: reader for the `HYDRodynamic COUPling DATA` group.
 
-Deck layout (FREAD rules, see decks/lines.py: keywords by their first four letters, `/` for
+Deck layout (FREAD rules, see decks/lines.py: keywords by their capitals, `/` for
 a default, `&` continues a line, `'` starts a comment, blanks or commas, D exponents)::
 
     BODY DATA                        ' minimal body declaration (optional, see below)
@@ -25,7 +25,12 @@ identifiers, TIMDEL, NRETij and the dofs have no default.
 
 Whole files: a SIMO system description file holds many other data groups (``SYSTem
 DESCription SIMO``, body data, environment, …).  The reader picks out the groups above and
-skips every other line; ``END`` ends the file.  The environment (``ENVIronment DATA
+skips every other line (strict inside our groups, lenient only between groups: decks/lines.py
+``Grammar``); ``END`` ends the file.  A line that resembles one of our keywords (too short,
+misspelt, values or words after it) is an error, as is a sub-group outside its coupling group
+or out of the manual's order (``COUPled ADDEd MASS`` after the retardation function), a second
+``SYSTem DESCription SIMO``, a data line after a finished group (a seventh added-mass row),
+and an unknown group whose lines read as more retardation blocks of the coupling it ended.  The environment (``ENVIronment DATA
 SPECification`` and its wave, wind and current groups) is skipped: the layout of its current
 group is not in any public material we found, so a SIMO current comes from SIMA's current
 file (``read_current_profile`` below) or the scene.  A line that starts like the coupling group
@@ -54,7 +59,8 @@ import numpy as np
 from ..admissible import symmetric
 from ..errors import InputError
 from . import units as unit_systems
-from .lines import DEFAULT, Cursor, check_profile, convert, fields, fread_lines, is_end, is_keyword, keyword_key
+from .lines import (DEFAULT, Cursor, Grammar, Reading, after_group, check_profile, convert, fields, fread_lines,
+                    interrupted, is_end, with_reading)
 
 GROUP = "HYDRodynamic COUPling DATA"
 BODY = "BODY DATA"
@@ -63,6 +69,8 @@ SYSTEM = "SYSTem DESCription SIMO"
 ADDED_MASS = "COUPled ADDEd MASS"
 RETARDATION = "COUPled RETArdation FUNCtion"
 ELEMENTS = "RETArdation ELEment DATA"
+GRAMMAR = Grammar([SYSTEM, BODY_SPEC, BODY, GROUP], inner=[ADDED_MASS, RETARDATION, ELEMENTS], once=[SYSTEM],
+                  stems=["HYDRodynamic COUPling"])
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([EeDd][+-]?\d+)?$")
 
 
@@ -87,45 +95,62 @@ class CouplingData:
 
 
 def read_couplings(path, bodies=None, units="SI"):
-    """Read every `HYDRodynamic COUPling DATA` group of a deck: {CHCPL: CouplingData}.
+    """Read every `HYDRodynamic COUPling DATA` group of a deck: {CHCPL: CouplingData}
+    (with ``.reading``: the groups used and skipped, decks/lines.py ``Reading``).
 
     ``bodies``: identifiers of the bodies defined before this file (e.g. by the scene).
     ``units``: the file's unit system (decks/units.py); values come back in SI.
     Raises InputError (file, line, field) on bad input.
     """
     cur = Cursor(fread_lines(path), path)
+    reading = Reading(str(path), "SIMO")
     declared = {}                                   # body → line of its BODY DATA group
     known = set(bodies or ())
-    out, pairs, system = {}, {}, None
+    out, pairs, system, once = {}, {}, None, {}
     while not cur.done():
+        pos = cur.pos
         line = cur.next("data group")
         if is_end(line):
             break
-        if is_keyword(line, SYSTEM):
+        key = GRAMMAR.find(line)
+        if key is None:                             # another data group of the file, or its data
+            reading.skip(line, pos)
+            continue
+        name = key.spelling
+        if key in GRAMMAR.inner:
+            raise line.error(name, f"{name!r} outside a {GROUP!r} group or out of the manual's order "
+                                   f"(CHBDY_B, then {ADDED_MASS!r}, then {RETARDATION!r})")
+        if name in GRAMMAR.once:
+            if name in once:
+                raise line.error(name, f"{name!r} given twice (first at line {once[name]}): a file has one")
+            once[name] = line.number
+        if name == SYSTEM:
             system = _system(cur, line)
-        elif is_keyword(line, BODY_SPEC):
-            known.add(cur.next("CHBDY").words[0])
-        elif is_keyword(line, BODY):
+            reading.use(f"{SYSTEM} (units line {system.line.number})", line)
+        elif name in (BODY, BODY_SPEC):
             body_line = cur.next("CHBDY")
-            name = fields(body_line, ["CHBDY"], str)["CHBDY"]
-            if name in declared:
-                raise body_line.error("CHBDY", f"body {name!r} declared twice "
-                                               f"(first at line {declared[name]})")
-            declared[name] = body_line.number
-            known.add(name)
-        elif is_keyword(line, GROUP):
+            body = fields(body_line, ["CHBDY"], str)["CHBDY"] if name == BODY else body_line.words[0]
+            if body in declared:
+                raise body_line.error("CHBDY", f"body {body!r} declared twice (first at line {declared[body]})")
+            declared[body] = body_line.number
+            known.add(body)
+            reading.use(f"{name} {body}", line)
+        else:
             data = _coupling(cur, line, known, out, pairs)
             out[data.name] = data
-        elif keyword_key(line.text)[:2] == keyword_key(GROUP)[:2]:
-            raise line.error("data group", f"expected {GROUP!r}, found {line.text!r}")
-        # any other line: another data group of the file, or its data: skipped
+            reading.use(f"{GROUP} {data.name}", line)
     unit_systems.check(system, units, path)
     mass, force = unit_systems.factors(units)
     for data in out.values():
         data.added_mass *= mass
         for ij in data.kernels:
             data.kernels[ij] *= force
-    return out
+    return with_reading(out, reading)
+
+
+def _starts_group(line):
+    """Between groups a FREAD line whose first word starts with a letter starts a group."""
+    return line.words[0][:1].isalpha()
 
 
 def _system(cur, head):
@@ -166,44 +191,60 @@ def _coupling(cur, start, known, out, pairs):
     pairs[pair] = name
     data = CouplingData(name, text, body["CHBDY_A"], body["CHBDY_B"], path=str(start.path), line=start.number)
 
-    given = False
-    nxt = cur.peek()
-    if nxt is not None and is_keyword(nxt, ADDED_MASS):
-        head, given = cur.next(ADDED_MASS), True
+    first = cur.peek()
+    if first is None:
+        raise cur.lines[-1].error(ADDED_MASS, f"expected {ADDED_MASS!r} and/or {RETARDATION!r} after CHBDY_B, "
+                                              f"found the end of file")
+    key = GRAMMAR.expect(first, ADDED_MASS, RETARDATION)
+    if key.spelling == ADDED_MASS:
+        head = cur.next(ADDED_MASS)
         for i in range(6):
             names = [f"AM{i + 1}{j + 1}" for j in range(6)]
             row = fields(cur.next(names[0]), names, slash=dict.fromkeys(names, 0.0))
             data.added_mass[i] = [row[n] for n in names]
         if data.body_a == data.body_b:
             _check_symmetric(head, data.added_mass)
-    nxt = cur.peek()
-    if nxt is not None and is_keyword(nxt, RETARDATION):
+        nxt = cur.peek()
+        key = GRAMMAR.find(nxt) if nxt is not None and not is_end(nxt) else None
+    if key is not None and key.spelling == RETARDATION:
         cur.next(RETARDATION)
-        given = True
         tl = cur.next("TIMDEL")
         data.timdel = fields(tl, ["TIMDEL"])["TIMDEL"]
         if not data.timdel > 0:
             raise tl.error("TIMDEL", f"must be > 0, found {data.timdel:g}")
         el = cur.next(ELEMENTS)
-        if not is_keyword(el, ELEMENTS):
-            raise el.error(ELEMENTS, f"expected {ELEMENTS!r}, found {el.text!r}")
+        GRAMMAR.expect(el, ELEMENTS)
         _blocks(cur, data, el)
-    if not given:
-        where = cur.peek() or cur.lines[-1]
-        raise where.error(ADDED_MASS, f"expected {ADDED_MASS!r} and/or {RETARDATION!r} after CHBDY_B, "
-                                      f"found {where.text if cur.peek() else 'end of file'!r}")
+        _stray(cur, data)
+    after_group(cur, _starts_group, f"the coupling {name!r} (line {start.number})")
     return data
 
 
-def _blocks(cur, data, head):
+def _stray(cur, data):
+    """An unknown group right after the retardation blocks whose lines read as further
+    blocks: a stray line inside the coupling (decks/lines.py ``interrupted``)."""
+    unknown = cur.peek()
+    if unknown is None or is_end(unknown) or GRAMMAR.find(unknown) is not None:
+        return
+    probe = Cursor(cur.lines[cur.pos + 1:], cur.path)
+
+    def rest():
+        _blocks(probe, CouplingData("", (), "", ""), unknown, report=False)
+        return True
+    interrupted(unknown, f"the retardation blocks of coupling {data.name!r}", rest)
+
+
+def _blocks(cur, data, head, report=True):
     """`NRETij IDOF_A IDOF_B` + values blocks, until a line that does not start with a number."""
     first = {}
     while True:
         nxt = cur.peek()
-        if nxt is not None and is_keyword(nxt, ELEMENTS):   # the identifier again before a block
-            cur.next(ELEMENTS)
-            continue
-        if nxt is None or not nxt.words or not _NUMBER.match(nxt.words[0]):
+        if nxt is None or is_end(nxt):
+            break
+        if not _NUMBER.match(nxt.words[0]):
+            if report and GRAMMAR.find(nxt) is GRAMMAR.inner[2]:   # the identifier again before a block
+                cur.next(ELEMENTS)
+                continue
             break
         hl = cur.next("NRETij")
         f = fields(hl, ["NRETij", "IDOF_A", "IDOF_B"], int)
@@ -324,4 +365,6 @@ def read_current_profile(path):
     extra = cur.peek()
     if extra is not None and not is_end(extra):
         raise extra.error(f"CURLEV({n + 1})", f"NCUR = {n} but more levels follow")
-    return check_profile(rows, where)
+    reading = Reading(str(path), "SIMA current")
+    reading.use(f"NCUR = {n} levels", head)
+    return with_reading(check_profile(rows, where, reading), reading)
