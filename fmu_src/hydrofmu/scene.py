@@ -55,6 +55,7 @@ class Scene:
     couplings: list = field(default_factory=list)
     current_profile: list = None     # [[z m, speed m/s, direction deg], ...] or None (uniform)
     warnings: list = field(default_factory=list)   # suspicious but legal input, said at load (InputWarning)
+    decks: list = field(default_factory=list)   # decks.lines.Reading of each deck read: used, skipped, warnings
 
 
 class Problems:
@@ -64,6 +65,14 @@ class Problems:
         self.path, self.items = Path(path), []
         self.unknown = {}  # key path of an unknown key -> the keys allowed there (batch knobs are checked by it)
         self.decks = {}   # (deck path, reader, args) -> entries or the InputError: each deck read once
+        self.readings = []   # what each deck read gave: groups used and skipped, warnings (decks.lines.Reading)
+
+    def read(self, found):
+        """Keep the ``reading`` of a deck reader's result (once); returns the result."""
+        reading = getattr(found, "reading", None)
+        if reading is not None and all(r is not reading for r in self.readings):
+            self.readings.append(reading)
+        return found
 
     def add(self, key, message):
         self.items.append((key, message))
@@ -89,7 +98,7 @@ class Problems:
         key = (str(path), reader, args)
         if key not in self.decks:
             try:
-                self.decks[key] = reader(path, *args)
+                self.decks[key] = self.read(reader(path, *args))
             except InputError as exc:
                 self.decks[key] = exc
                 if not any(isinstance(v, InputError) and str(v) == str(exc) for k, v in self.decks.items()
@@ -750,7 +759,7 @@ def _load_scene(path, overrides=None):
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
-        bodies=bodies, run=run_cfg,
+        bodies=bodies, run=run_cfg, decks=p.readings,
     )
     p.raise_if_any()
     return scene
@@ -833,7 +842,7 @@ def _current_deck(problems, env):
     if fmt == "riflex":
         return _riflex_current(problems, env, path)
     try:
-        return (read_current_profile if fmt == "deeplines" else read_sima)(path)
+        return problems.read((read_current_profile if fmt == "deeplines" else read_sima)(path))
     except InputError as exc:
         problems.add("environment.current_deck", str(exc))
         return None

@@ -15,6 +15,8 @@ allowed, numbers separated by commas and/or blanks)::
 
 ``TYPE`` may only be ``MATRIX`` (the default when the line is left out); ``OPTION`` is
 ``ABSOLUTE`` (default when left out) or ``RELATIVE`` (body velocity relative to the current).
+The settings follow the manual's order (TYPE, OPTION, then the rows or ``VISCOUS DRAG``), each
+at most once: a setting after a later one is an error (it would belong to another body).
 
 Named matrices (the manual's "Body - Viscous Drag Coefficients" table), hydrofmu's
 plain-text layout: a matrix is defined once under a name in a ``*Viscous Drag
@@ -59,6 +61,7 @@ DRAG, TABLE = "*Viscous Drag", "*Viscous Drag Coefficients"
 GRAMMAR = Grammar([DRAG, TABLE], stems=["*Viscous"], exact=True)
 _BODY, _TYPE, _OPTION, _REF, _NAME = (tuple(k.split()) for k in
                                       ("FLOATING BODY", "TYPE", "OPTION", "VISCOUS DRAG", "NAME"))
+_ORDER = (_TYPE, _OPTION, _REF)      # the settings of a body block, in the manual's order
 
 
 @dataclass
@@ -175,6 +178,11 @@ def _read_bodies(block, lines, end, bodies, refs):
             if key in settings:
                 raise block[i].error(label, f"given twice for body {name!r} "
                                             f"(first at line {settings[key][0].number})")
+            later = [k for k in settings if _ORDER.index(k) > _ORDER.index(key)]
+            if later:
+                raise block[i].error(label, f"out of the manual's order for body {name!r}: FLOATING BODY, then "
+                                            f"TYPE, OPTION, then the matrix or VISCOUS DRAG (found after "
+                                            f"{' '.join(later[0])} at line {settings[later[0]][0].number})")
             settings[key] = (block[i], value)
             i += 1
         if _TYPE in settings:

@@ -315,17 +315,17 @@ def after_group(cur, starts_group, owner, expected="a new data group"):
 
 
 def interrupted(unknown, owner, rest):
-    """An unknown group that ends one of ours where its layout allows, but whose lines read
-    as more of ours (``rest()`` parses them without error), is a stray line inside our group:
-    an error, not a skipped group."""
+    """A group (one we skip) that ends one of ours where its layout allows, but whose lines
+    read as more of ours (``rest()`` parses them without error), is a stray line inside our
+    group: an error, not a skipped group."""
     try:
         ok = rest()
     except InputError:
         return
     if ok:
-        raise unknown.error("data group", f"{unknown.text!r} starts no group hydrofmu reads, but the lines after it "
-                                          f"read as more of {owner}: a stray line inside that group? "
-                                          f"(remove it, or move the group it starts)")
+        raise unknown.error("data group", f"{unknown.text!r} ends {owner} where its layout allows, but the lines "
+                                          f"after it read as more of that group: a stray or misplaced line inside "
+                                          f"it? (remove it, or move the group it starts)")
 
 
 def fields(line, names, kind=float, defaults=None, slash=None):

@@ -26,8 +26,8 @@ A line starts a data group when it is a NEW line or all its words begin with a l
 group without its IRX line; any other line left after one of our groups is an error (a
 level beyond NCULEV, a fourth CONB line).  A line that resembles one of our keywords
 (``UNIT NA SPEC``, ``NEW COMP BOD``, words after it) is an error, as is a second ``UNIT NAMe
-SPECification`` and an unknown group right after a CONB whose first line reads as its
-IRX IRY IRZ line (a stray line inside the CONB group).
+SPECification`` and a group right after a CONB whose first line reads as the CONB's IRX IRY
+IRZ line (a stray or misplaced line inside the CONB group).
 """
 from dataclasses import dataclass, replace
 
@@ -185,8 +185,8 @@ def _read_group(cur, head, kind, seen):
     nxt = cur.peek()
     if nxt is not None and not starts_group(nxt):
         codes = _codes(cur.next("IRX"))
-    elif nxt is not None and not is_end(nxt) and GRAMMAR.find(nxt) is None and cur.pos + 1 < len(cur.lines):
-        after = cur.lines[cur.pos + 1]      # an unknown group after the CONB: is its first line our IRX line?
+    elif nxt is not None and not is_end(nxt) and cur.pos + 1 < len(cur.lines):
+        after = cur.lines[cur.pos + 1]      # the group after the CONB: is its first line our IRX line?
         interrupted(nxt, f"CONB {name!r} (its IRX IRY IRZ line)", lambda: not starts_group(after) and _codes(after))
     return ConbData(**common, codes=codes)
 

@@ -233,6 +233,7 @@ def manifest(scene, system, conns):
         "connections": conns,
         "bonds": osp.scalar_bonds(osp.bonds(system)),
         "warnings": list(scene.warnings),   # suspicious but legal input, as the build said it
+        "decks": [reading.as_dict() for reading in scene.decks],
     }
 
 
