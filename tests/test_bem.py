@@ -189,7 +189,7 @@ def test_extrapolated_a_inf_close_to_capytaine_infinite_frequency():
     ref = d.a_inf.copy()
     d.a_inf = None
     r = couplings(d, {"cyl1": "cyl1", "cyl2": "cyl2"}).radiation
-    assert r.a_inf_source == "extrapolated"
+    assert r.a_inf_source == "Ogilvie"
     on = np.diag(r.active)
     diag = np.diag(ref)[on]
     np.testing.assert_allclose(np.diag(r.a_inf)[on], diag, rtol=0.01)
@@ -304,6 +304,87 @@ def test_built_fmu_reproduces_bem_coefficients(tmp_path, method):
     assert checked >= 5 * 10
 
 
+def full_resolution(top):
+    """The dataset's A(ω), B(ω) (symmetrised) at its frequencies ≤ top, and each pair's scale
+    √(peak_ii·peak_jj) over them (for A and for B)."""
+    d = read_capytaine(CYL)
+    band = d.omega <= top + 1e-9
+    a, b = (0.5 * (m + m.transpose(0, 2, 1)) for m in (d.added_mass[band], d.damping[band]))
+    scale = [np.sqrt(np.outer(p, p)) for p in (np.abs(np.diagonal(m, axis1=1, axis2=2)).max(axis=0) for m in (a, b))]
+    return d, d.omega[band], a, b, scale
+
+
+COARSE = {   # sub-grids of the dataset's 0.05…5 rad/s (Δω = 0.05) up to 3.5 rad/s
+    "45 nearest to an even spacing of 0.078 rad/s": lambda w: np.unique(
+        [np.argmin(np.abs(w - x)) for x in np.linspace(3.5 / 45, 3.5, 45)]),
+    "every other one, Δω = 0.1 rad/s (35)": lambda w: np.nonzero((np.arange(w.size) % 2 == 1) & (w <= 3.5 + 1e-9))[0],
+}
+
+
+@pytest.mark.parametrize("grid", list(COARSE))
+def test_coarse_grid_rebuilds_the_full_resolution_values(grid):
+    """The transform of a coarse sub-grid (≤ 3.5 rad/s) rebuilds A(ω), B(ω) at every frequency
+    of the full dataset in that range, between the grid's points too (the kernels as the
+    convolution uses them): every self and cross pair within 1 % of √(peak_ii·peak_jj).  The
+    file's A∞ also within 1 % of the one the transform finds (Ogilvie, consistent with K)."""
+    from hydrofmu.physics.radiation import transform
+    d, w, a, b, (scale_a, scale_b) = full_resolution(3.5)
+    sel = COARSE[grid](d.omega)
+    r = transform(d.omega[sel], d.added_mass[sel], d.damping[sel], d.a_inf)
+    assert 35 <= sel.size <= 45 and r.a_inf_source == "Ogilvie" and np.isclose(r.omega[-1], 3.5)
+    between = ~np.isin(w, d.omega[sel]) & (w > d.omega[sel][0])
+    assert between.sum() >= 20
+    fit_a, fit_b = r.rebuilt(w)
+    on = r.active
+    assert np.diag(on).sum() == 10 and on[1, 7] and on[1, 9]     # yaw is noise; cross sway–sway, sway–roll
+    err_a = np.max(np.abs(fit_a - a), axis=0)[on] / scale_a[on]
+    err_b = np.max(np.abs(fit_b - b), axis=0)[on] / scale_b[on]
+    print(f"{grid}: worst A {100 * err_a.max():.2f} %, B {100 * err_b.max():.2f} % of √(peak_ii·peak_jj)")
+    assert err_a.max() < 0.01 and err_b.max() < 0.01, (err_a.max(), err_b.max())
+    ref = 0.5 * (d.a_inf + d.a_inf.T)
+    assert np.max(np.abs(r.a_inf - ref)[on] / np.sqrt(np.outer(np.diag(ref), np.diag(ref)))[on]) < 0.01
+
+
+def test_built_fmu_on_a_coarse_grid_gives_the_full_resolution_values(tmp_path):
+    """The dataset cut to every other frequency up to 3.5 rad/s (Δω = 0.1, ω = ∞ kept) built
+    into load FMUs; body a driven in sway at 0.25, 0.75, …, 3.25 rad/s (each midway between two
+    grid frequencies, where the spline of B works hardest): A and B of every pair (i, a sway),
+    self (a, a) and cross (b, a) — the cross-body sway added mass among them — within 1 % of
+    √(peak_ii·peak_jj) of the full-resolution dataset's values."""
+    d, w, a, b, (scale_a, scale_b) = full_resolution(3.5)
+    ds = xr.load_dataset(CYL)
+    keep = [x for x in ds.omega.values if np.isinf(x) or (round(x * 20) % 2 == 0 and x <= 3.5 + 1e-9)]
+    path = tmp_path / "coarse.nc"
+    ds.sel(omega=keep).to_netcdf(path)
+    text = bodies_text().replace("[run]", "[scene]\n        name = \"bem\"\n        [run]") \
+        + bem_text(path, 'method = "convolution"')
+    scene = load_scene(write_scene(tmp_path, text))
+    rad = scene.couplings[0].bem.radiation
+    assert rad.omega.size == 35 and rad.length < 60.0
+    folder = build(tmp_path, text)
+    omega0, per_period = 0.25, 500
+    dt = 2 * np.pi / omega0 / per_period
+    n_steps = int(np.ceil(rad.length / dt)) + per_period
+    ks = [1, 3, 5, 7, 9, 11, 13]
+    amp = 0.02
+    fa, fb = harmonic_run(folder, {1: (amp, ks)}, dt, n_steps, omega0)
+    t = dt * np.arange(n_steps + 1)[-per_period:]
+    worst = {"A": 0.0, "B": 0.0}
+    for body, forces in ((0, fa[-per_period:]), (6, fb[-per_period:])):
+        for i in range(5):
+            for k in ks:
+                wk = omega0 * k
+                q = int(np.argmin(np.abs(w - wk)))
+                assert abs(w[q] - wk) < 1e-9 and wk not in rad.omega
+                f = forces[:, i]
+                a_fmu = 2 / per_period * np.sum(f * np.sin(wk * t)) / (amp * wk ** 2)
+                b_fmu = -2 / per_period * np.sum(f * np.cos(wk * t)) / (amp * wk)
+                worst["A"] = max(worst["A"], abs(a_fmu - a[q, body + i, 1]) / scale_a[body + i, 1])
+                worst["B"] = max(worst["B"], abs(b_fmu - b[q, body + i, 1]) / scale_b[body + i, 1])
+    print(f"coarse grid through the FMU: worst A {100 * worst['A']:.2f} %, B {100 * worst['B']:.2f} % of √(peak_ii·peak_jj)")
+    assert worst["A"] < 0.01 and worst["B"] < 0.01, worst
+
+
 # --- bad input ------------------------------------------------------------------------
 
 def bad(tmp_path, text):
@@ -367,6 +448,27 @@ def test_asymmetric_a_inf_beyond_tolerance(tmp_path):
     scene = load_scene(write_scene(tmp_path, bodies_text() + bem_text(path, "symmetry_tolerance = 0.2")))
     am = np.array(scene.couplings[0].added_mass)
     np.testing.assert_allclose(am, am.T)
+
+
+def test_a_inf_from_the_file_when_asked(tmp_path):
+    """`a_inf = "file"` keeps the file's ω = ∞ added mass (symmetrised); the default finds it by
+    Ogilvie's relation, within 1 % of √(A_ii·A_jj) of the file's; a file without ω = ∞ and
+    a_inf = "file", or another value, are errors naming the key."""
+    ds = xr.load_dataset(CYL)
+    ref = ds.added_mass.sel(omega=np.inf, influenced_dof="cyl1__Sway", radiating_dof="cyl2__Sway").item()
+    ref = 0.5 * (ref + ds.added_mass.sel(omega=np.inf, influenced_dof="cyl2__Sway",
+                                         radiating_dof="cyl1__Sway").item())
+    diag = [ds.added_mass.sel(omega=np.inf, influenced_dof=f"cyl{k}__Sway", radiating_dof=f"cyl{k}__Sway").item()
+            for k in (1, 2)]
+    kept = load_scene(write_scene(tmp_path, bodies_text() + bem_text(extra='a_inf = "file"\nkernel_length = 20.0')))
+    found = load_scene(write_scene(tmp_path, bodies_text() + bem_text(), "o.toml"))
+    cross = lambda scene: next(c for c in scene.couplings if c.a != c.b).added_mass[1][1]
+    assert cross(kept) == pytest.approx(ref, rel=1e-12)
+    assert cross(found) != cross(kept) and abs(cross(found) - ref) < 0.01 * np.sqrt(diag[0] * diag[1])
+    assert "a_inf: expected one of 'ogilvie', 'file'" in bad(tmp_path, bodies_text() + bem_text(extra='a_inf = "x"'))
+    path = variant(tmp_path, lambda ds: ds.sel(omega=ds.omega[np.isfinite(ds.omega)]))
+    msg = bad(tmp_path, bodies_text() + bem_text(path, 'a_inf = "file"'))
+    assert str(path) in msg and "a_inf: a_inf = \"file\" but the file has no infinite-frequency added mass" in msg
 
 
 def test_rotation_centre_must_match_the_reference_point(tmp_path):

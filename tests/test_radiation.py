@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from hydrofmu.physics.radiation import AsymmetryError, GridError, hat_transform, transform
+from hydrofmu.physics.radiation import AsymmetryError, GridError, cubic_transform, hat_transform, transform
 
 # K(t) = e^{−αt}·cos βt − c·e^{−γt}, c = γα/(α² + β²) so that B(0) = ∫K dt = 0
 ALPHA, BETA, GAMMA = 0.5, 1.5, 1.0
@@ -44,6 +44,19 @@ def test_hat_transform_is_exact_for_piecewise_linear():
         np.testing.assert_allclose(hat_transform(nodes, x, kind) @ f, ref, atol=1e-8)
 
 
+def test_cubic_transform_is_exact_for_a_spline():
+    """∫ of a cubic spline times cos(xs), against a fine trapezoid sum of the same spline (x = 0,
+    small x where the series replace the closed forms, and large x)."""
+    from scipy.interpolate import CubicSpline
+    spline = CubicSpline([0.0, 0.3, 1.0, 1.7, 4.0], np.array([[0.0, 2.0, -1.0, 0.5, 0.25],
+                                                              [1.0, 0.0, 3.0, -2.0, 0.0]]).T, axis=0)
+    x = np.array([0.0, 1e-4, 0.9, 3.0, 25.0, 300.0])
+    s = np.linspace(0, 4, 400001)
+    fs = spline(s)
+    ref = [[np.trapezoid(fs[:, k] * np.cos(xx * s), s) for k in range(2)] for xx in x]
+    np.testing.assert_allclose(cubic_transform(spline.x, spline.c, x), ref, atol=1e-8)
+
+
 def test_kernel_and_extrapolated_a_inf_match_the_analytic_pair():
     """B on 0.05…10 rad/s with its ω⁻² tail: K within 0.5 % of K(0), A∞ (Ogilvie) within
     0.5 %, the tail exponent near 2, and A, B rebuilt within 1 % of their peaks."""
@@ -53,17 +66,22 @@ def test_kernel_and_extrapolated_a_inf_match_the_analytic_pair():
     assert 2.0 <= r.tail_exponent < 2.4        # B ~ 0.3/ω² + O(ω⁻⁴): a bit steeper at 8…10 rad/s
     assert np.abs(r.kernels[0, 0] - kernel(t)).max() < 0.005 * kernel(0.0)
     assert abs(r.a_inf[0, 0] - A_INF) < 0.005 * A_INF
-    assert r.a_inf_source == "extrapolated"
+    assert r.a_inf_source == "Ogilvie"
     assert r.err_a[0, 0] < 1.0 and r.err_b[0, 0] < 1.0
     assert abs(r.timdel - np.pi / (12 * 10.0)) < 1e-12       # TIMDEL from the highest frequency
     assert abs(kernel(r.length)) < 0.01 * kernel(0.0)          # the kernel ends where it has decayed
 
 
-def test_file_a_inf_used_and_asked_timdel_and_length_kept():
+def test_file_a_inf_used_when_asked_and_asked_timdel_and_length_kept():
+    """By default A∞ comes from Ogilvie's relation even when the file has it (here within
+    0.5 % of the exact value); a_inf_from="file" keeps the file's value as it is."""
     w, a, b = grid()
-    r = transform(w, a, b, a_inf=np.array([[A_INF]]), timdel=0.03, length=20.0)
+    r = transform(w, a, b, a_inf=np.array([[A_INF]]), timdel=0.03, length=20.0, a_inf_from="file")
     assert r.a_inf_source == "file" and r.a_inf[0, 0] == A_INF
     assert r.timdel == 0.03 and abs(r.length - 20.0) < 0.03
+    r = transform(w, a, b, a_inf=np.array([[A_INF]]))
+    assert r.a_inf_source == "Ogilvie" and abs(r.a_inf[0, 0] - A_INF) < 0.005 * A_INF
+    assert any("the file's ω = ∞ value differs by" in n for n in r.notes)
 
 
 def test_short_range_warns_about_the_tail():
@@ -86,7 +104,7 @@ def test_asymmetry_within_tolerance_is_symmetrised_beyond_is_an_error():
     a = np.tile(np.array([[2.0, 0.3], [0.3, 1.0]]), (w.size, 1, 1))
     b = damping(w)[:, None, None] * np.array([[1.0, 0.1], [0.1, 0.5]])
     a_inf = np.array([[2.0, 0.301], [0.299, 1.0]])          # 0.14 % of √(2·1)
-    r = transform(w, a, b, a_inf=a_inf)
+    r = transform(w, a, b, a_inf=a_inf, a_inf_from="file")
     assert r.a_inf[0, 1] == r.a_inf[1, 0] == pytest.approx(0.3)
     assert r.asymmetry == pytest.approx(0.002 / np.sqrt(2))
     with pytest.raises(AsymmetryError, match="asymmetry"):
@@ -95,10 +113,15 @@ def test_asymmetry_within_tolerance_is_symmetrised_beyond_is_an_error():
 
 def test_multi_dof_result_rebuilt_within_one_percent():
     """Three analytic modes mixed over 6 dofs (the bench's synthetic result): every pair's A
-    and B rebuilt within 1 % of its peak, A∞ from the file kept."""
+    and B rebuilt within 1 % of its peak, with A∞ from Ogilvie's relation (within 0.1 % of
+    the exact one) and with the file's A∞ kept."""
     from hydrofmu.bench.radiation_cost import synthetic
     w, a, b, a_inf = synthetic(6, 200, top=8.0)
     r = transform(w, a, b, a_inf)
     assert r.active.all()
+    assert r.err_a.max() < 1.0 and r.err_b.max() < 1.0
+    scale = np.sqrt(np.outer(np.diag(a_inf), np.diag(a_inf)))
+    assert np.abs(r.a_inf - a_inf).max() < 1e-3 * scale.min()
+    r = transform(w, a, b, a_inf, a_inf_from="file")
     assert r.err_a.max() < 1.0 and r.err_b.max() < 1.0
     np.testing.assert_array_equal(r.a_inf, a_inf)

@@ -36,7 +36,8 @@ class BemCouplings:
 
     def report(self):
         """Build-time report lines: the transform's choices, then per coupling the worst rebuilt
-        A and B errors (% of each curve's peak) with their dof pair, then warnings."""
+        A and B errors (% of each curve's peak, and % of the pair's √(peak_ii·peak_jj)) with their
+        dof pair, then warnings."""
         r = self.radiation
         lines = [f"BEM {self.data.kind} {self.data.path}: {len(self.labels)} dofs, {r.omega.size} frequencies "
                  f"{r.omega[0]:g}…{r.omega[-1]:g} rad/s, transform {r.seconds:.2f} s"]
@@ -52,11 +53,14 @@ class BemCouplings:
         if r.asymmetry:
             lines.append(f"  A∞ symmetrised (largest asymmetry {100 * r.asymmetry:.3g} % of √(A_ii·A_jj))")
         for c, rows, cols in self._blocks():
-            ea, eb = r.err_a[np.ix_(rows, cols)], r.err_b[np.ix_(rows, cols)]
-            ia, ib = np.unravel_index(np.argmax(ea), ea.shape), np.unravel_index(np.argmax(eb), eb.shape)
+            worst = []
+            for e in (r.err_a, r.err_b, r.pair_a, r.pair_b):
+                e = e[np.ix_(rows, cols)]
+                i, j = np.unravel_index(np.argmax(e), e.shape)
+                worst.append(f"{e[i, j]:.3g} % ({self.labels[rows[i]]}, {self.labels[cols[j]]})")
             lines.append(f"  coupling {c.name} ({c.body_a}, {c.body_b}): {len(c.kernels)} kernels; rebuilt A worst "
-                         f"{ea[ia]:.3g} % ({self.labels[rows[ia[0]]]}, {self.labels[cols[ia[1]]]}), B worst "
-                         f"{eb[ib]:.3g} % ({self.labels[rows[ib[0]]]}, {self.labels[cols[ib[1]]]}) of each curve's peak")
+                         f"{worst[0]}, B worst {worst[1]} of each curve's peak; A {worst[2]}, B {worst[3]} "
+                         f"of the pair's √(peak_ii·peak_jj)")
         lines += [f"  WARNING: {w}" for w in self.warnings]
         return lines
 
@@ -78,13 +82,16 @@ def label(body, k):
     return f"{body}__{DOF_NAMES[k - 1]}"
 
 
-def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SYMMETRY_TOL, prefix=None):
+def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SYMMETRY_TOL, prefix=None,
+              a_inf_from="ogilvie"):
     """Couplings of the BEM bodies mapped in ``bodies`` ({BEM body: name to use}).
 
     dofs: dof names to keep ("Surge", …; default every dof in the file), each must be in the
     file for every mapped body.  timdel, length [s]: asked kernel spacing and length.
     prefix: coupling names are ``<prefix>_<a>`` (self) and ``<prefix>_<a>_<b>`` (cross), or
-    ``<a>`` and ``<a>_<b>`` without one.  Raises InputError naming the file and the field.
+    ``<a>`` and ``<a>_<b>`` without one.  a_inf_from: "ogilvie" (A∞ consistent with the
+    kernels, the default) or "file" (the file's ω = ∞ value; an error when it has none).
+    Raises InputError naming the file and the field.
     """
     path = data.path
     for name, value in (("timdel", timdel), ("kernel_length", length), ("symmetry_tolerance", symmetry_tol)):
@@ -111,13 +118,16 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
                                                               + ", ".join(label(*d) for d in data.dofs if d[0] == b))
                 continue
             keep.append(i)
+    if a_inf_from == "file" and data.a_inf is None:
+        raise InputError(path, None, "a_inf", "a_inf = \"file\" but the file has no infinite-frequency added mass "
+                                              "(Capytaine: omega = inf; WAMIT: PER = 0)")
     sel = np.ix_(range(data.omega.size), keep, keep)
     kept = [data.dofs[i] for i in keep]
     try:
         rad = transform(data.omega, data.added_mass[sel], data.damping[sel],
                         None if data.a_inf is None else data.a_inf[np.ix_(keep, keep)],
                         units=[k >= 4 for _, k in kept], timdel=timdel, length=length, symmetry_tol=symmetry_tol,
-                        labels=[label(bodies[b], k) for b, k in kept])
+                        labels=[label(bodies[b], k) for b, k in kept], a_inf_from=a_inf_from)
     except AsymmetryError as exc:
         i, j = exc.pair
         raise InputError(path, None, f"added_mass[inf][{label(*kept[i])}, {label(*kept[j])}]",

@@ -126,7 +126,7 @@ def validate(paths):
 
 
 def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_length=None,
-             symmetry_tolerance=None, png=None, log=print):
+             symmetry_tolerance=None, png=None, log=print, a_inf="ogilvie"):
     """A BEM result (Capytaine .nc, WAMIT .1) → a SIMO deck with every self and cross coupling
     of its bodies (BODY DATA groups first); the transform's report goes to ``log``."""
     from .bem import couplings, plot_quality, write_simo
@@ -139,7 +139,7 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
     check_outputs(files=(out, png))
     data = read_bem(result, ulen=ulen, rho=rho)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
-                     SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance)
+                     SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance, a_inf_from=a_inf)
     for line in made.report():
         log(line)
     made.written = {Path(out): keep(lambda p: write_simo(made, p), out, _stderr)[0]}
@@ -271,6 +271,8 @@ def make_parser():
     m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
     m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")
     m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
+    m.add_argument("--a-inf", choices=("ogilvie", "file"), default="ogilvie",
+                   help="A∞ from Ogilvie's relation, consistent with the kernels (default), or the file's ω = ∞ value")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     return parser
 
@@ -350,7 +352,7 @@ def _main(argv):
         return code
     elif args.command == "bem2simo":
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
-                        args.symmetry_tolerance, args.png)
+                        args.symmetry_tolerance, args.png, a_inf=args.a_inf)
         return _wrote(made)[1]
     elif args.command == "bench":
         from .bench.run import main as bench

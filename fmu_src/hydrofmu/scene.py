@@ -485,7 +485,7 @@ def _coupling(name, a, b, d, knobs, bem=None):
                          method, tol, order, length, set_, bem=bem)
 
 
-BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance",
+BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance", "a_inf",
             "rotation_centers", "method", "tolerance", "order", "memory_length"}
 CENTRE_TOL = 0.01   # m: BEM rotation centres vs scene reference points
 
@@ -510,11 +510,12 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
         dofs = None
     opt = {k: problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None
            for k in ("ulen", "timdel", "kernel_length", "symmetry_tolerance")}
+    a_inf_from = problems.choice(table, "a_inf", f"{where}.a_inf", ("ogilvie", "file"), "ogilvie")
     knobs = _memory_knobs(problems, table, where, memory)
     centres = problems.table(table, "rotation_centers", f"{where}.rotation_centers", required=False) or {}
     centres = {b: problems.vector(centres, b, f"{where}.rotation_centers.{b}", 3) for b in centres}
     if file is None or mapping is None or knobs[0] is None or prefix is None or not identifier(prefix) \
-            or None in centres.values():
+            or a_inf_from is None or None in centres.values():
         if prefix is not None and not identifier(prefix):
             problems.add(f"{where}.name", f"expected an identifier, found {prefix!r}")
         return []
@@ -541,7 +542,7 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
             data.rotation_centers[b] = list(xyz)
         _check_centres(data, mapping, bodies)
         result = bem.couplings(data, mapping, dofs, opt["timdel"], opt["kernel_length"],
-                               opt["symmetry_tolerance"] or SYMMETRY_TOL, prefix)
+                               opt["symmetry_tolerance"] or SYMMETRY_TOL, prefix, a_inf_from)
     except InputError as exc:
         problems.add(f"{where}.bem", str(exc))
         return []
