@@ -166,7 +166,7 @@ class Result:
         """Write the run as CSV, headers with units (``time [s]``, ``barge.force[1] [N]``,
         attitude in rad); returns the path.  Values are written with full precision
         (``repr``).  The file appears whole or not at all; a missing folder is an
-        InputError naming it."""
+        InputError naming it (another failure to write, an OSError)."""
         path = Path(path)
         if not path.parent.is_dir():
             raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
@@ -178,9 +178,8 @@ class Result:
                 for t, row in zip(self.time, self.values):
                     w.writerow([repr(float(t))] + [repr(float(x)) for x in row])
             tmp.replace(path)
-        except OSError as exc:
+        finally:   # a failed write leaves nothing (the OSError goes on: writable.keep may try elsewhere)
             tmp.unlink(missing_ok=True)
-            raise InputError(path, None, "output file", f"cannot write ({exc.strerror or exc})") from None
         return path
 
     def plot(self, path) -> Path:
