@@ -17,14 +17,23 @@ from .names import did_you_mean
 from .writable import check_folder, check_outputs, keep
 
 
-def scenes_in(paths, models="models"):
-    """Scene files named on the command line, or every *.toml in models/."""
+# the repository's models/ when hydrofmu is installed from it (pip install -e .)
+REPO_MODELS = Path(__file__).resolve().parents[2] / "models"
+
+
+def scenes_in(paths, models=None):
+    """Scene files named on the command line, or every *.toml in ``models`` (default:
+    ./models, else the models/ of the repository hydrofmu was installed from)."""
     if paths:
         return [Path(p) for p in paths]
-    found = sorted(Path(models).glob("*.toml"))
-    if not found:
-        raise InputError(models, None, "models", "no scene files (*.toml) found")
-    return found
+    folders = [Path(models)] if models else [Path("models"), REPO_MODELS]
+    for folder in folders:
+        found = sorted(folder.glob("*.toml"))
+        if found:
+            return found
+    raise InputError(Path(folders[0]).resolve(), None, "scenes",
+                     "no scene files (*.toml) here" + ("" if models else " nor in the hydrofmu repository's models/")
+                     + ": name scene files, or run from a folder that has models/*.toml")
 
 
 def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
