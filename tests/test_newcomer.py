@@ -47,3 +47,49 @@ def test_plot_panels_say_zero_and_clipping_where_they_cover_nothing():
     title = clipped.get_title()
     assert title.startswith("Fx [kN]\naxis clipped to the settled run; data span -700") and clipped.get_ylim()[0] > -700
     plt.close(fig)
+
+
+def _figures(monkeypatch):
+    """The figures a plot function makes (kept open instead of closed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    figs = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig))
+    return figs
+
+
+def test_batch_polar_plot_has_units_and_one_legend_off_the_panels(tmp_path, monkeypatch):
+    import pandas as pd
+    from hydrofmu.batch import load_cases, plot
+    batch = load_cases({"scene": str(ROOT / "models" / "moored_barge.toml"), "outputs": ["barge.force[1]"],
+                        "matrix": {"environment.current_speed": [0.5, 1.0],
+                                   "environment.current_direction": [0.0, 90.0, 180.0]}}, tmp_path)
+    rows = [{"environment.current_speed": s, "environment.current_direction": d, "status": "ok",
+             "barge.force[1].max": s * 1e3, "barge.force[1].min": -s * 1e3} for s in (0.5, 1.0) for d in (0, 90, 180)]
+    figs = _figures(monkeypatch)
+    plot(pd.DataFrame(rows), batch, tmp_path / "cases.png", {"barge.force[1]": "N"})
+    (fig,) = figs
+    ax = fig.axes[0]
+    assert ax.get_title() == "max |barge.force[1]| [N]" and ax.get_legend() is None
+    (legend,) = fig.legends
+    assert legend.get_title().get_text() == "environment.current_speed"
+    assert [t.get_text() for t in legend.get_texts()] == ["0.5", "1.0"]
+    # the legend sits below every panel
+    fig.canvas.draw()
+    assert legend.get_window_extent().y1 <= min(a.get_window_extent().y0 for a in fig.axes)
+
+
+def test_bem_quality_plot_has_y_units_and_readable_text(tmp_path, monkeypatch):
+    from hydrofmu.bem import couplings, plot_quality
+    from hydrofmu.decks.bem import read_bem
+    data = read_bem(ROOT / "tests" / "data" / "bem" / "cylinders.nc")
+    made = couplings(data, {b: b for b in data.bodies}, ["Sway", "Roll"])   # 4 dofs: each kind of pair
+    figs = _figures(monkeypatch)
+    plot_quality(made, tmp_path / "q.png")
+    (fig,) = figs
+    labels = {(a.get_title().split("\n")[0], a.get_ylabel()) for a in fig.axes if a.get_visible()}
+    assert ("A: cyl1__Sway, cyl1__Sway", "A [kg]") in labels
+    assert ("B: cyl1__Roll, cyl1__Roll", "B [kg·m²/s]") in labels
+    assert ("A: cyl1__Sway, cyl1__Roll", "A [kg·m]") in labels
+    assert min(a.title.get_fontsize() for a in fig.axes) >= 9
