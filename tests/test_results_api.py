@@ -42,13 +42,13 @@ def test_names_time_counts_and_closest_names():
     np.testing.assert_array_equal(r.motion("barge", "position"), r.motion("barge", "position", 3))
     assert r.motion("barge", "velocity").shape == (len(r.time), 6)
     assert r.vector("barge", "drag.force").shape == (len(r.time), 6)
-    with pytest.raises(UnknownName, match=r"unknown column 'barge.forc\[1\]'; closest: barge.force\[1\]"):
+    with pytest.raises(UnknownName, match=r"unknown column 'barge.forc\[1\]' \(did you mean 'barge.force\[1\]'"):
         r["barge.forc[1]"]
-    with pytest.raises(KeyError, match="unknown body 'barg'; closest: barge"):
+    with pytest.raises(KeyError, match=r"unknown body 'barg' \(did you mean 'barge'\?\); valid: barge$"):
         r.motion("barg", "position")
-    with pytest.raises(ValueError, match="unknown instance 'bargee'; closest: barge"):
+    with pytest.raises(ValueError, match="unknown instance 'bargee' \\(did you mean 'barge'"):
         r.vector("bargee", "force")
-    with pytest.raises(UnknownName, match="unknown variable 'drag.forc' of instance 'barge'; closest: drag.force"):
+    with pytest.raises(UnknownName, match="unknown variable 'drag.forc' of instance 'barge' \\(did you mean 'drag.force'"):
         r.vector("barge", "drag.forc")
     with pytest.raises(UnknownName, match=r"unknown column 'barge.force\[7\]'"):
         r.vector("barge", "force", 7)
