@@ -359,6 +359,8 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
     """A table of ordinary slips, one or more per command: each ends in exit 2 and one
     error line naming the file (or the command line) and the field, never exit 3."""
     monkeypatch.chdir(tmp_path)
+    # no models/ here, nor a repository's to fall back on (test_newcomer: the fallback)
+    monkeypatch.setattr(cli_module, "REPO_MODELS", tmp_path / "no_repository" / "models")
     afile = tmp_path / "afile"
     afile.write_text("x")
     junk = tmp_path / "junk.fmu"
@@ -371,7 +373,7 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
         (["build", tmp_path / "none.toml"], "none.toml: file: cannot read scene"),
         (["build", tmp_path / "bad.toml"], "bad.toml:1: toml:"),
         (["build", scene, "-o", afile], "afile: output folder: is a file, not a folder"),
-        (["build"], "models: models: no scene files"),
+        (["build"], "models: scenes: no scene files (*.toml) here"),
         (["run", tmp_path / "none.toml"], "none.toml: file: cannot read scene"),
         (["run", scene, "--stop", "1.05", "-o", tmp_path / "o"], "--stop: stop 1.05 s is not a whole number of steps"),
         (["run", scene, "--png", tmp_path / "empty"], "empty: output file: is a folder"),
@@ -388,7 +390,7 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
         (["bem2simo", junk, "-o", tmp_path / "x.sim"], "junk.fmu: bem: expected a Capytaine NetCDF dataset"),
         (["bem2simo", tmp_path / "none.1", "-o", tmp_path / "x.sim"], "none.1: ulen:"),
         (["bench", "-o", afile, "--part", "overhead"], "afile: output folder: is a file, not a folder"),
-        (["demo", "-o", tmp_path / "d"], "models: models: no scene files"),
+        (["demo", "-o", tmp_path / "d"], "models: scenes: no scene files (*.toml) here"),
     ]
     for args, words in table:
         code, line, _ = cli(*args)

@@ -17,3 +17,79 @@ def test_example_case_file_is_a_valid_batch_of_a_repository_scene():
     batch = load_cases(ROOT / "examples" / "cases.toml")
     assert batch.scene == (ROOT / "models" / "moored_barge.toml").resolve()
     assert len(list(batch.cases())) == 3 * 5 + 1
+
+
+def test_demo_outside_the_repository_finds_its_scenes_or_says_what_to_do(tmp_path, monkeypatch, capsys):
+    from hydrofmu import cli
+    monkeypatch.chdir(tmp_path)                    # no models/ here
+    assert cli.scenes_in([]) == sorted((ROOT / "models").glob("*.toml"))
+    monkeypatch.setattr(cli, "REPO_MODELS", tmp_path / "nowhere")
+    assert cli.main(["demo"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "models: models:" not in err
+    assert err.startswith(f"error: {tmp_path / 'models'}: scenes: no scene files (*.toml) here")
+    assert not (tmp_path / "build").exists()
+
+
+def test_plot_panels_say_zero_and_clipping_where_they_cover_nothing():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from hydrofmu.cosim.report import _panel
+    t = np.linspace(0, 100, 1001)
+    fig, (zero, clipped) = plt.subplots(1, 2)
+    _panel(zero, t, [("drag", 2, np.zeros_like(t)), ("total", 2, np.zeros_like(t))], "yaw moment Mz [kN·m]", {})
+    assert [x.get_text() for x in zero.texts] == ["zero throughout"] and list(zero.get_yticks()) == [0]
+    spike = np.where(t < 2, -700.0, 50.0 + np.sin(t))
+    _panel(clipped, t, [("drag", 0, spike)], "Fx [kN]", {})
+    assert not clipped.texts                                   # no box over the data or the ticks
+    title = clipped.get_title()
+    assert title.startswith("Fx [kN]\naxis clipped to the settled run; data span -700") and clipped.get_ylim()[0] > -700
+    plt.close(fig)
+
+
+def _figures(monkeypatch):
+    """The figures a plot function makes (kept open instead of closed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    figs = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig))
+    return figs
+
+
+def test_batch_polar_plot_has_units_and_one_legend_off_the_panels(tmp_path, monkeypatch):
+    import pandas as pd
+    from hydrofmu.batch import load_cases, plot
+    batch = load_cases({"scene": str(ROOT / "models" / "moored_barge.toml"), "outputs": ["barge.force[1]"],
+                        "matrix": {"environment.current_speed": [0.5, 1.0],
+                                   "environment.current_direction": [0.0, 90.0, 180.0]}}, tmp_path)
+    rows = [{"environment.current_speed": s, "environment.current_direction": d, "status": "ok",
+             "barge.force[1].max": s * 1e3, "barge.force[1].min": -s * 1e3} for s in (0.5, 1.0) for d in (0, 90, 180)]
+    figs = _figures(monkeypatch)
+    plot(pd.DataFrame(rows), batch, tmp_path / "cases.png", {"barge.force[1]": "N"})
+    (fig,) = figs
+    ax = fig.axes[0]
+    assert ax.get_title() == "max |barge.force[1]| [N]" and ax.get_legend() is None
+    (legend,) = fig.legends
+    assert legend.get_title().get_text() == "environment.current_speed"
+    assert [t.get_text() for t in legend.get_texts()] == ["0.5", "1.0"]
+    # the legend sits below every panel
+    fig.canvas.draw()
+    assert legend.get_window_extent().y1 <= min(a.get_window_extent().y0 for a in fig.axes)
+
+
+def test_bem_quality_plot_has_y_units_and_readable_text(tmp_path, monkeypatch):
+    from hydrofmu.bem import couplings, plot_quality
+    from hydrofmu.decks.bem import read_bem
+    data = read_bem(ROOT / "tests" / "data" / "bem" / "cylinders.nc")
+    made = couplings(data, {b: b for b in data.bodies}, ["Sway", "Roll"])   # 4 dofs: each kind of pair
+    figs = _figures(monkeypatch)
+    plot_quality(made, tmp_path / "q.png")
+    (fig,) = figs
+    labels = {(a.get_title().split("\n")[0], a.get_ylabel()) for a in fig.axes if a.get_visible()}
+    assert ("A: cyl1__Sway, cyl1__Sway", "A [kg]") in labels
+    assert ("B: cyl1__Roll, cyl1__Roll", "B [kg·m²/s]") in labels
+    assert ("A: cyl1__Sway, cyl1__Roll", "A [kg·m]") in labels
+    assert min(a.title.get_fontsize() for a in fig.axes) >= 9

@@ -109,15 +109,31 @@ def _hydrofmu(*args, cwd):
                           text=True, timeout=300)
 
 
-def test_run_writes_csv_and_png_next_to_the_build_and_says_where(tmp_path):
+def test_run_writes_csv_png_and_summary_next_to_the_build_and_says_where(tmp_path):
+    import json
     out = tmp_path / "fmus"
     done = _hydrofmu("run", str(MODELS / "moored_barge.toml"), "-o", str(out), "--stop", "1", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
-    csv, png = out / "moored_barge.csv", out / "moored_barge.png"
+    csv, png, summary = out / "moored_barge.csv", out / "moored_barge.png", out / "moored_barge.summary.json"
     assert f"in {out / 'moored_barge'}" in done.stdout             # where it built
-    assert f"wrote {csv} and {png}" in done.stdout                  # where it wrote
+    assert f"wrote {csv}, {png} and {summary}" in done.stdout       # where it wrote
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert len(read_csv(csv).time) == 11
+    result = read_csv(csv)
+    assert len(result.time) == 11
+    # the run's settings once, without a "preset none"; the summary printed and written
+    text = done.stdout + done.stderr
+    assert text.count("step 0.1 s, gauss-seidel") == 1 and "preset none" not in text
+    assert "summary of moored_barge" in done.stdout and "barge  total" in done.stdout
+    stats = json.loads(summary.read_text())["bodies"]["barge"]
+    fx = result["barge.force[1]"]
+    assert stats["total"]["Fx"]["unit"] == "N" and stats["total"]["Fx"]["max"] == fx.max()
+    assert stats["attitude"]["yaw"]["unit"] == "rad"
+    # the same scene again: the FMUs are reused, not rebuilt
+    manifest = out / "moored_barge" / "manifest.json"
+    before = manifest.stat().st_mtime_ns
+    again = _hydrofmu("run", str(MODELS / "moored_barge.toml"), "-o", str(out), "--stop", "1", cwd=tmp_path)
+    assert again.returncode == 0 and f"reusing {out / 'moored_barge'}" in again.stdout, again.stderr
+    assert "built scene" not in again.stdout and manifest.stat().st_mtime_ns == before
 
 
 def test_every_option_has_a_help_text():

@@ -5,7 +5,11 @@ command line (``hydrofmu build``/``run``) is a thin layer over them.
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import sys
+import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 
@@ -18,7 +22,8 @@ if TYPE_CHECKING:
 
 DEFAULT_OUT = Path("build") / "fmus"
 
-__all__ = ["load_scene", "build", "run", "outputs"]
+__all__ = ["load_scene", "build", "run", "outputs", "inputs_hash", "built_folder"]
+PACKAGE = Path(__file__).resolve().parent
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -73,9 +78,64 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
     """
     from .fmi.build import build_scene
 
+    inputs = None
     if not isinstance(scene, Scene):
+        inputs = inputs_hash(scene)
         scene = load_scene(scene)
-    return Path(build_scene(scene, Path(out), log=log))
+    return Path(build_scene(scene, Path(out), log=log, inputs=inputs))
+
+
+def _files_named(value, base):
+    """Existing files that string values of a TOML document name (relative to ``base``)."""
+    if isinstance(value, dict):
+        value = list(value.values())
+    if isinstance(value, list):
+        return [f for v in value for f in _files_named(v, base)]
+    if isinstance(value, str) and value:
+        try:
+            f = (base / value).resolve()
+            return [f] if f.is_file() else []
+        except (OSError, ValueError):
+            return []
+    return []
+
+
+def inputs_hash(path: str | Path) -> str | None:
+    """What a build of the scene file ``path`` depends on, as one hash: the scene's bytes,
+    every file its values name (decks, BEM results, current files: any string that is a
+    file relative to the scene), hydrofmu's own sources and the Python version.  None
+    when the file cannot be read as TOML (the build then reports why)."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+        doc = tomllib.loads(data.decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+    h = hashlib.sha256(sys.version.encode())
+    h.update(data)
+    for f in sorted(set(_files_named(doc, path.resolve().parent))):
+        h.update(str(f).encode())
+        h.update(f.read_bytes())
+    for f in sorted(PACKAGE.rglob("*")):
+        if f.suffix in (".py", ".c", ".h") and f.is_file():
+            h.update(f.relative_to(PACKAGE).as_posix().encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()[:20]
+
+
+def built_folder(path: str | Path, out: str | Path = DEFAULT_OUT) -> Path | None:
+    """``out/<scene name>/`` when it holds a build of the scene file ``path`` that is up to
+    date (its manifest records the same `inputs_hash`), else None."""
+    h = inputs_hash(path)
+    if h is None:
+        return None
+    try:
+        name = tomllib.loads(Path(path).read_text(encoding="utf-8-sig")).get("scene", {}).get("name", Path(path).stem)
+        folder = Path(out) / str(name)
+        manifest = json.loads((folder / "manifest.json").read_text())
+    except (OSError, ValueError, AttributeError):
+        return None
+    return folder if manifest.get("inputs") == h else None
 
 
 def run(source: str | Path | Scene, *, stop: float | None = None, step: float | None = None,
@@ -88,7 +148,9 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     ----------
     source : str, Path or Scene
         A scene file (``.toml``) or Scene, built into ``out/<scene name>/`` first, or a
-        built scene folder (holding ``manifest.json``).
+        built scene folder (holding ``manifest.json``).  A scene file whose build in
+        ``out`` is up to date (same scene, decks and hydrofmu: `built_folder`) is not
+        built again.
     stop, step : float, optional
         End time and communication step [s]; default: the scene's ``[run]`` settings
         (its preset's, unless the scene sets them).
@@ -106,7 +168,8 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     parameters : mapping, optional
         ``{'instance.variable': value}`` set in initialization mode (fmpy engine).
     log : callable, default print
-        Receives the build's lines when a scene file is built.
+        Receives the build's lines when a scene file is built, or the line saying which
+        build is reused.
 
     Returns
     -------
@@ -123,10 +186,20 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
             raise InputError("run", None, key, f"must be a positive finite number, found {value!r}")
     folder = source
     if isinstance(source, Scene) or Path(source).suffix == ".toml":
-        scene = source if isinstance(source, Scene) else load_scene(source)
-        # the run's own stop/step checked against the scene's before anything is built
-        check_steps(stop or scene.run["stop"], step or scene.run["step"], algorithm or scene.run["algorithm"], "run")
-        folder = build(scene, out, log=log)
+        reuse = None if isinstance(source, Scene) else built_folder(source, out)
+        if reuse is not None:
+            cfg = json.loads((reuse / "manifest.json").read_text())["run"]
+            check_steps(stop or cfg["stop"], step or cfg["step"], algorithm or cfg["algorithm"], "run")
+            log(f"reusing {reuse}: the scene, its decks and hydrofmu are unchanged since it was built")
+            folder = reuse
+        else:
+            from .fmi.build import build_scene
+            inputs = None if isinstance(source, Scene) else inputs_hash(source)
+            scene = source if isinstance(source, Scene) else load_scene(source)
+            # the run's own stop/step checked against the scene's before anything is built
+            check_steps(stop or scene.run["stop"], step or scene.run["step"], algorithm or scene.run["algorithm"],
+                        "run")
+            folder = Path(build_scene(scene, Path(out), log=log, inputs=inputs))
     elif not (Path(folder) / "manifest.json").is_file():
         raise InputError(folder, None, "source", "not a scene (.toml) nor a built scene folder (no manifest.json)")
     from .cosim.libcosim import engine_for

@@ -684,7 +684,19 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
         for c in closing:
             c.close()
         bar.close()
-    return assemble_table(out, ids, batch)
+    return assemble_table(out, ids, batch, _output_units(variants, batch.outputs))
+
+
+def _output_units(variants, outputs):
+    """Output -> unit, from the FMUs of the first build that succeeded ({} if none did)."""
+    from .cosim.result import column_units
+    for v in variants.builds.values():
+        if v.folder is not None and v.error is None:
+            try:
+                return column_units(v.folder, json.loads((v.folder / "manifest.json").read_text()), outputs)
+            except (OSError, KeyError, ValueError):
+                return {}
+    return {}
 
 
 def _collect(future, inflight, record):
@@ -712,7 +724,7 @@ def read_series(out, case):
     return pd.read_parquet(Path(out) / "series" / f"{case}.parquet")
 
 
-def assemble_table(out, ids, batch):
+def assemble_table(out, ids, batch, units=None):
     """The batch table from the per-case files: one row per case (knobs, status, wall time,
     statistics, error, case id, build id); written as cases.csv, cases.parquet and the plot."""
     import pandas as pd
@@ -726,7 +738,7 @@ def assemble_table(out, ids, batch):
     table = pd.DataFrame(rows, columns=columns)
     table.to_csv(Path(out) / "cases.csv", index=False)
     table.to_parquet(Path(out) / "cases.parquet", index=False)
-    plot(table, batch, Path(out) / "cases.png")
+    plot(table, batch, Path(out) / "cases.png", units)
     return table
 
 
@@ -737,9 +749,11 @@ def _cell(value):
 DIRECTION_HINTS = ("direction", "heading")
 
 
-def plot(table, batch, path):
+def plot(table, batch, path, units=None):
     """Largest |output| per case: a polar plot against the first direction knob (one line per
-    combination of the other knobs), else against the first numeric knob; None if neither."""
+    combination of the other knobs, one legend for the figure below the panels), else against
+    the first numeric knob; ``units``: output -> unit, in each panel's title.  None if there
+    is nothing to plot."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -751,8 +765,9 @@ def plot(table, batch, path):
     axis = next((k for k in numeric if any(h in k.lower() for h in DIRECTION_HINTS)), numeric[0])
     polar = any(h in axis.lower() for h in DIRECTION_HINTS)
     others = [k for k in batch.matrix if k != axis and len(batch.matrix[k]) > 1]
+    units = units or {}
     n = len(batch.outputs)
-    fig, axes = plt.subplots(1, n, figsize=(5 * n, 4.8), squeeze=False,
+    fig, axes = plt.subplots(1, n, figsize=(5 * n, 5.4), squeeze=False,
                              subplot_kw={"projection": "polar"} if polar else {})
     for ax, name in zip(axes[0], batch.outputs):
         peak = np.maximum(ok[f"{name}.max"].abs(), ok[f"{name}.min"].abs())
@@ -761,17 +776,23 @@ def plot(table, batch, path):
             g = g.sort_values(axis)
             x = np.radians(g[axis].to_numpy(float)) if polar else g[axis].to_numpy(float)
             y = peak[g.index].to_numpy()
-            label = ", ".join(f"{k} = {v}" for k, v in zip(others, label if isinstance(label, tuple) else (label,)))
+            label = ", ".join(f"{v}" for v in (label if isinstance(label, tuple) else (label,)))
             ax.plot(x, y, "o-", label=label or None)
-        ax.set_title(f"max |{name}|", fontsize=9)
-        if not polar:
+        unit = units.get(name)
+        ax.set_title(f"max |{name}|" + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=9, pad=14)
+        ax.tick_params(labelsize=8)
+        if polar:
+            ax.set_rlabel_position(100)   # radial values off the 0° and 90° spokes
+        else:
             ax.set_xlabel(axis)
             ax.grid(True, alpha=0.3)
-        if others:
-            ax.legend(fontsize=7)
+    if others:   # one legend for the figure, below the panels: it covers no label
+        handles, labels = axes[0][0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
+                   title=", ".join(others), title_fontsize=8)
     fig.suptitle(f"{batch.scene.stem}: largest value per case against {axis}"
-                 + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10)
-    fig.tight_layout()
+                 + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10, y=0.98)
+    fig.tight_layout(rect=(0, 0.1 if others else 0, 1, 0.92))
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

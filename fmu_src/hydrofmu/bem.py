@@ -10,6 +10,7 @@ and B(ω) rebuilt from (A∞, K) against the database.
 """
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -207,19 +208,39 @@ def plot_quality(result, path, most=16):
     pairs = [(i, i) for i in range(n) if r.active[i, i]]
     cross = sorted(((size[i, j], i, j) for i in range(n) for j in range(i + 1, n) if r.active[i, j]), reverse=True)
     pairs = (pairs + [(i, j) for _, i, j in cross])[:most]
-    fig, axes = plt.subplots(len(pairs), 2, figsize=(10, 1.8 * len(pairs) + 0.6), squeeze=False)
+    per_row = 2   # pairs side by side: A, B, A, B
+    rows = -(-len(pairs) // per_row)
+    fig, axes = plt.subplots(rows, 2 * per_row, figsize=(17, 2.7 * rows + 1.0), squeeze=False)
     w = r.omega
-    for row, (i, j) in enumerate(pairs):
-        for ax, db, fit, err, what in ((axes[row, 0], r.a_db, r.a_fit, r.err_a, "A"),
-                                       (axes[row, 1], r.b_db, r.b_fit, r.err_b, "B")):
-            ax.plot(w, db[:, i, j], ".", ms=3, label="database")
-            ax.plot(w, fit[:, i, j], "-", lw=1, label="from A∞, K(t)")
-            ax.set_title(f"{what} {result.labels[i]}, {result.labels[j]}: worst {err[i, j]:.2g} % of peak", fontsize=8)
-            ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=7)
+    for k, (i, j) in enumerate(pairs):
+        row, col = divmod(k, per_row)
+        rot = _rotations(result.labels[i]) + _rotations(result.labels[j])   # 0, 1 or 2 rotational dofs
+        units = {"A": ("kg", "kg·m", "kg·m²")[rot], "B": ("kg/s", "kg·m/s", "kg·m²/s")[rot]}
+        for ax, db, fit, err, what in ((axes[row, 2 * col], r.a_db, r.a_fit, r.err_a, "A"),
+                                       (axes[row, 2 * col + 1], r.b_db, r.b_fit, r.err_b, "B")):
+            ax.plot(w, db[:, i, j], ".", ms=4, label="database")
+            ax.plot(w, fit[:, i, j], "-", lw=1.2, label="rebuilt from A∞, K(t)")
+            ax.set_title(f"{what}: {result.labels[i]}, {result.labels[j]}\nworst {err[i, j]:.2g} % of peak",
+                         fontsize=10)
+            ax.set_ylabel(f"{what} [{units[what]}]", fontsize=9)
+            ax.tick_params(labelsize=8)
+            ax.grid(True, alpha=0.3)
+    for k in range(len(pairs), rows * per_row):   # an odd count leaves one pair's place empty
+        row, col = divmod(k, per_row)
+        axes[row, 2 * col].set_visible(False)
+        axes[row, 2 * col + 1].set_visible(False)
     for ax in axes[-1]:
-        ax.set_xlabel("ω [rad/s]", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=80)
+        ax.set_xlabel("ω [rad/s]", fontsize=9)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper right", fontsize=9, frameon=False, ncol=2)
+    fig.suptitle(f"{Path(result.data.path).name}: radiation A(ω), B(ω) of the database and rebuilt from the "
+                 f"kernels (diagonal pairs, then the largest cross pairs)", fontsize=11, x=0.02, ha="left")
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / fig.get_figheight()))
+    fig.savefig(path, dpi=90)
     plt.close(fig)
     return path
+
+
+def _rotations(label):
+    """1 when a dof label (``Roll``, ``cyl1__Pitch``, …) names a rotation, else 0."""
+    return int(label.rsplit("__", 1)[-1].lower() in ("roll", "pitch", "yaw"))

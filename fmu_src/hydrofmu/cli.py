@@ -9,7 +9,7 @@ import warnings
 import zipfile
 from pathlib import Path
 
-from .api import DEFAULT_OUT, outputs
+from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
 from .cosim.master import describe
 from .cosim.master import check_steps
 from .errors import InputError, InputWarning
@@ -17,14 +17,23 @@ from .names import did_you_mean
 from .writable import check_folder, check_outputs, keep
 
 
-def scenes_in(paths, models="models"):
-    """Scene files named on the command line, or every *.toml in models/."""
+# the repository's models/ when hydrofmu is installed from it (pip install -e .)
+REPO_MODELS = Path(__file__).resolve().parents[2] / "models"
+
+
+def scenes_in(paths, models=None):
+    """Scene files named on the command line, or every *.toml in ``models`` (default:
+    ./models, else the models/ of the repository hydrofmu was installed from)."""
     if paths:
         return [Path(p) for p in paths]
-    found = sorted(Path(models).glob("*.toml"))
-    if not found:
-        raise InputError(models, None, "models", "no scene files (*.toml) found")
-    return found
+    folders = [Path(models)] if models else [Path("models"), REPO_MODELS]
+    for folder in folders:
+        found = sorted(folder.glob("*.toml"))
+        if found:
+            return found
+    raise InputError(Path(folders[0]).resolve(), None, "scenes",
+                     "no scene files (*.toml) here" + ("" if models else " nor in the hydrofmu repository's models/")
+                     + ": name scene files, or run from a folder that has models/*.toml")
 
 
 def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
@@ -44,14 +53,15 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
     if not check:
         check_folder(outdir)
     folders = {}
-    for s in scenes:
-        folders[s.name] = build_scene(s, outdir, log=log, check=check)
+    for s in scenes:   # the inputs' hash lets a later run of the same scene file reuse the build
+        folders[s.name] = build_scene(s, outdir, log=log, check=check, inputs=inputs_hash(s.path))
         if not check:
             log(f"built scene {s.name}: FMUs, manifest.json, OSP files and {s.name}.ssp in {folders[s.name]}")
     return folders
 
 
-def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, algorithm=None, out=None):
+def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, algorithm=None, out=None,
+              summary=None):
     """Bad run arguments as one InputError, before anything is built or written: step and
     stop positive, stop a whole number of steps (``run``: the scene's or the built folder's
     [run] settings, for what the command line leaves out), every output writable."""
@@ -67,27 +77,38 @@ def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, a
         check_steps(stop or run["stop"], step or run["step"], algorithm or run["algorithm"],
                     "command line" if given else run.get("source", folder),
                     {"stop": "--stop", "step": "--step"} if given else {"stop": "run.stop", "step": "run.step"})
-    check_outputs(files=(csv, png), folders=(out,))
+    check_outputs(files=(csv, png, summary), folders=(out,))
 
 
 def _stderr(text):
     print(text, file=sys.stderr)
 
 
-def run_folder(folder, engine=None, csv=None, png=None, log=_stderr, **kw):
+def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=0.0, log=_stderr, say=print, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
-    an ECCO run, else fmpy); write CSV/PNG (checked writable first; a write that fails after
-    the run goes to a fallback folder: ``written`` maps each asked path to the one written)."""
+    an ECCO run, else fmpy), its settings said once first (``say``); write CSV/PNG and the
+    summary's JSON (checked writable first; a write that fails after the run goes to a
+    fallback folder: ``written`` maps each asked path to the one written).  The Result's
+    ``stats`` is its summary over t ≥ ``transient``."""
     from .cosim.libcosim import engine_for
+    from .cosim.master import run_settings
     folder = Path(folder)
-    check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"))
+    check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"), summary=summary)
+    if not (math.isfinite(transient) and transient >= 0):
+        raise InputError("command line", None, "--transient", f"must be a finite time ≥ 0 [s], found {transient:g}")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
+        raise InputError("command line", None, "--transient",
+                         f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
     else:
         from .cosim.master import run
+    say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
     result = run(folder, **kw)
+    result.stats = result.summary(transient)
     result.written = {}
-    for path, write in ((csv, result.to_csv), (png, result.plot)):
+    for path, write in ((csv, result.to_csv), (png, result.plot), (summary, result.stats.to_json)):
         if path:
             result.written[Path(path)] = keep(write, path, log)[0]
     return result
@@ -97,7 +118,8 @@ def _wrote(result):
     """'wrote a and b' of a command's outputs (``result.written``: asked path → path written);
     the exit code: 1 when one went to a fallback folder."""
     moved = [asked for asked, got in result.written.items() if got != asked]
-    text = " and ".join(str(p) for p in result.written.values())
+    paths = [str(p) for p in result.written.values()]
+    text = ", ".join(paths[:-1]) + " and " + paths[-1] if len(paths) > 1 else "".join(paths)
     return f"wrote {text}" + (f" ({len(moved)} of them not where asked: see the warning)" if moved else ""), \
         (1 if moved else 0)
 
@@ -209,7 +231,10 @@ def make_parser():
                        description="Run a scene and write its results: the CSV (header 'instance.variable "
                                    "[unit]', one row per communication point) and the PNG (motion from the initial "
                                    "pose, every load, joint gaps) next to the built folder, <folder>.csv and "
-                                   "<folder>.png, unless --csv/--png say otherwise.  Step, stop and algorithm "
+                                   "<folder>.png, unless --csv/--png say otherwise, and the summary (mean, std, "
+                                   "min, max of each body's motion and loads per dof, with units): printed and "
+                                   "written as <folder>.summary.json.  A scene file whose build in OUT is up to "
+                                   "date is not built again.  Step, stop and algorithm "
                                    "default to the scene's [run] settings (its preset's).")
     r.add_argument("scene", metavar="SCENE", help="scene file (.toml, built into OUT first) or built scene folder")
     r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="where a .toml scene is built")
@@ -224,6 +249,8 @@ def make_parser():
     r.add_argument("--stop", type=float, metavar="T", help="end time [s] (default: the scene's)")
     r.add_argument("--csv", type=Path, metavar="FILE", help="CSV file to write (default: <folder>.csv)")
     r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")
+    r.add_argument("--transient", type=float, default=0.0, metavar="T",
+                   help="the summary's statistics leave out t < T [s]")
     a = sub.add_parser("batch", formatter_class=fmt,
                        description="Run a matrix of load cases (a case file: a scene and the values to vary) on Dask: one table of results (cases.csv, cases.parquet) and plots; exit code 1 when a case failed.",
                        help="run a matrix of load cases (a case file) on Dask: one table, plots")
@@ -317,7 +344,11 @@ def _main(argv):
         return 1 if validate(args.paths) else 0
     elif args.command == "run":
         folder = Path(args.scene)
-        if folder.suffix == ".toml":
+        reuse = built_folder(folder, args.out) if folder.suffix == ".toml" else None
+        if reuse is not None:
+            folder = reuse
+            print(f"reusing {folder}: the scene, its decks and hydrofmu are unchanged since it was built")
+        elif folder.suffix == ".toml":
             from .scene import load_scene
             scene = load_scene(folder)
             # the default CSV/PNG go into OUT, which the build makes: OUT is checked for them
@@ -326,10 +357,11 @@ def _main(argv):
             folder = next(iter(build([scene], args.out).values()))
         csv, png = outputs(folder)
         csv, png = args.csv or csv, args.png or png
-        result = run_folder(folder, args.engine, csv, png, stop=args.stop, step=args.step,
-                            algorithm=args.algorithm)
+        result = run_folder(folder, args.engine, csv, png, folder.with_name(folder.name + ".summary.json"),
+                            args.transient, stop=args.stop, step=args.step, algorithm=args.algorithm)
+        print(result.stats)
         wrote, code = _wrote(result)
-        print(f"ran {folder.name}: {len(result.time) - 1} steps ({describe(result.settings)}); {wrote}")
+        print(f"ran {folder.name}: {len(result.time) - 1} steps; {wrote}")
         return code
     elif args.command == "batch":
         return batch(args)
@@ -345,10 +377,11 @@ def _main(argv):
         code = 0
         for name in args.scene or folders:
             csv, png = outputs(folders[name])
-            result = run_folder(folders[name], "fmpy", csv, png)
+            result = run_folder(folders[name], "fmpy", csv, png, folders[name].with_name(name + ".summary.json"))
             wrote, failed = _wrote(result)
             code = max(code, failed)
-            print(f"ran {name}: {len(result.time) - 1} steps ({describe(result.settings)}); {wrote}")
+            print(f"ran {name}: {len(result.time) - 1} steps; {wrote} (the summary: mean, std, min, max "
+                  f"per body and dof)")
         return code
     elif args.command == "bem2simo":
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,

@@ -37,3 +37,18 @@ def unknown(what: str, name: str, valid: Iterable[str], show: int = 12) -> str:
     valid = list(dict.fromkeys(str(v) for v in valid))
     listed = ", ".join(valid[:show]) + (f", … ({len(valid) - show} more)" if len(valid) > show else "")
     return f"unknown {what} {name!r}{did_you_mean(name, valid)}; valid: {listed or 'none'}"
+
+
+class UnknownName(KeyError, ValueError):
+    """A name that is not there (a result's column, instance, variable or body): ``kind``,
+    the ``name`` asked for, and `unknown`'s message (the closest names, then the valid
+    ones).  A KeyError (a failed lookup) and a ValueError (what ``list.index`` raised
+    before), printed as plain text."""
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str], where: str = ""):
+        self.kind, self.name = kind, name
+        self.message = unknown(kind, name, valid).replace(f"{name!r}", f"{name!r}{where}", 1)
+        super().__init__(self.message)
+
+    def __str__(self):
+        return self.message

@@ -56,7 +56,7 @@ def run_settings(manifest, step=None, algorithm=None, stop=None):
 
 
 def describe(settings):
-    """One line naming the preset and every knob of a run."""
+    """One line naming the preset (when there is one) and every knob of a run."""
     memory = "; ".join(
         f"{name}: {c['method']}" + (f" tol {c['tolerance']:g}" if c["method"] == "state_space" and not c["order"]
                                     else f" order {c['order']}" if c["order"] else "")
@@ -67,7 +67,8 @@ def describe(settings):
     algorithm = settings["algorithm"] + (
         f" (steps {ecco['min_step']:g}–{ecco['max_step']:g} s, energy tolerance rel {ecco['rel_tolerance']:g}, "
         f"abs {ecco['abs_tolerance']:g} J)" if ecco else "")
-    return (f"preset {settings['preset'] or 'none'}: {'first ' if ecco else ''}step {settings['step']:g} s, {algorithm}, "
+    return ((f"preset {settings['preset']}: " if settings["preset"] else "")
+            + f"{'first ' if ecco else ''}step {settings['step']:g} s, {algorithm}, "
             f"{settings['load_hold']} load hold, substep {settings['substep']:g} s"
             + (f"; set by the scene/run: {', '.join(settings['set'])}" if settings["set"] else "")
             + (f"; memory {memory}" if memory else ""))
@@ -370,9 +371,6 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                         "run", "parameters", "parameter or input")
         values = np.empty((n + 1, len(record)))
         progress = n > 2000 if progress is None else progress
-        if progress:
-            sys.stderr.write(f"{system.manifest['scene']}: "
-                             f"{describe(run_settings(system.manifest, step, algorithm, stop))}\n")
         tty = sys.stderr.isatty()
         every = max(1, n // (20 if tty else 4))  # a live line on a terminal, four lines in a log
 

@@ -133,15 +133,19 @@ def _panel(ax, t, curves, title, colours, robust=True):
     for effect, comp, y in curves:
         ax.plot(t, y, color=colours.get(effect, "black"), ls=LINESTYLES[comp],
                 lw=2.0 if effect == TOTAL else 1.2)
-    ax.set_title(title, fontsize=9)
     ax.grid(True, alpha=0.3)
-    if curves and robust:
+    if curves and all(np.all(np.asarray(y) == 0) for _, _, y in curves):
+        # nothing to see: say so instead of an empty ±1 axis
+        ax.set_ylim(-1, 1)
+        ax.set_yticks([0])
+        ax.text(0.5, 0.62, "zero throughout", transform=ax.transAxes, ha="center", va="center",
+                fontsize=9, color="0.35")
+    elif curves and robust:
         lo, hi, clipped = robust_limits(t, [y for _, _, y in curves])
         ax.set_ylim(lo, hi)
-        if clipped:
-            ax.text(0.01, 0.02, f"axis clipped to the settled run; data span {clipped[0]:.3g} … {clipped[1]:.3g}",
-                    transform=ax.transAxes, fontsize=7, color="0.25",
-                    bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.85))
+        if clipped:   # in the title, where it covers no data and no tick label
+            title += f"\naxis clipped to the settled run; data span {clipped[0]:.3g} … {clipped[1]:.3g}"
+    ax.set_title(title, fontsize=9)
 
 
 def plot(result, manifest, path):
@@ -179,7 +183,7 @@ def plot(result, manifest, path):
         _panel(axes[r, 1], t, kn(0) + kn(1), f"{body}: horizontal force Fx, Fy [kN]", colours)
         _panel(axes[r, 2], t, kn(2), f"{body}: vertical force Fz [kN]", colours)
         _panel(axes[r + 1, 0], t, [(None, i, np.degrees(datt[:, i])) for i in range(3)],
-               f"{body}: rotation roll, pitch, yaw from ({a0}) deg [deg]", colours, robust=False)
+               f"{body}: rotation roll, pitch, yaw from ({a0}) deg [deg; the CSV has rad]", colours, robust=False)
         _panel(axes[r + 1, 1], t, kn(5), f"{body}: yaw moment Mz [kN·m]", colours)
         _panel(axes[r + 1, 2], t, kn(3) + kn(4), f"{body}: roll, pitch moments Mx, My [kN·m]", colours)
         r += 2

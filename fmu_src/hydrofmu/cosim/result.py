@@ -10,11 +10,16 @@ import json
 import re
 import zipfile
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from ..errors import InputError
+from ..names import UnknownName
+
+DYNAMICS = re.compile(r"^(?P<instance>[^.]+_dynamics)\.(?:(?P<body>[^.\[]+)\.)?position\[1\]$")
 HEADER = re.compile(r"^(?P<name>.*\S)\s+\[(?P<unit>[^\[\]]*)\]$")  # name, blank, [unit]
 
 
@@ -53,43 +58,141 @@ class Result:
     units: dict = field(default_factory=dict)
     manifest: dict = None
 
+    def __repr__(self):
+        n = len(self.time)
+        span = f"t = {self.time[0]:g}–{self.time[-1]:g} s" if n else "no points"
+        scene = " " + self.manifest["scene"] if self.manifest else ""
+        how = ", ".join(filter(None, [self.algorithm, f"step {self.step:g} s" if self.step else ""]))
+        bodies = ", ".join(sorted(self.layout()[0]["dynamics"])) or "none found"
+        extra = "" if self.manifest else "; no manifest (plot and joint loads need one)"
+        return (f"<Result{scene}: {n} points, {span}" + (f", {how}" if how else "")
+                + f"; {len(self.columns)} columns; bodies {bodies}{extra}>")
+
+    @cached_property
+    def _index(self):
+        return {c: i for i, c in enumerate(self.columns)}
+
     def __getitem__(self, column: str) -> np.ndarray:
-        """The time series (n,) of one column, ``'instance.variable'``."""
-        return self.values[:, self.columns.index(column)]
+        """The time series (n,) of one column, ``'instance.variable'``, or ``'time'``."""
+        if column == "time":
+            return self.time
+        i = self._index.get(column)
+        if i is None:
+            raise UnknownName("column", column, ["time"] + self.columns)
+        return self.values[:, i]
 
-    def vector(self, instance: str, name: str, n: int) -> np.ndarray:
-        """(n_times, n) array of ``instance.name[1..n]``."""
-        return np.column_stack([self[f"{instance}.{name}[{i}]"] for i in range(1, n + 1)])
+    def __contains__(self, column) -> bool:
+        return column == "time" or column in self._index
 
-    def motion(self, body: str, name: str, n: int) -> np.ndarray:
+    def instances(self) -> list:
+        """The FMU instances that have recorded columns."""
+        return sorted({c.split(".", 1)[0] for c in self.columns})
+
+    def vector(self, instance: str, name: str, n: int | None = None) -> np.ndarray:
+        """(n_times, n) array of ``instance.name[1..n]``; ``n`` defaults to every
+        component recorded (``name[1]``, ``name[2]``, … as long as they exist)."""
+        if n is None:
+            n = 0
+            while f"{instance}.{name}[{n + 1}]" in self._index:
+                n += 1
+        missing = [k for k in range(1, n + 1) if f"{instance}.{name}[{k}]" not in self._index]
+        if n == 0 or missing:
+            if instance not in self.instances():
+                raise UnknownName("instance", instance, self.instances())
+            variables = {re.sub(r"\[\d+\]$", "", c.split(".", 1)[1]) for c in self.columns
+                         if c.startswith(f"{instance}.")}
+            if name in variables:
+                raise UnknownName("column", f"{instance}.{name}[{missing[0]}]", self.columns)
+            raise UnknownName("variable", name, variables, f" of instance {instance!r}")
+        return np.column_stack([self.values[:, self._index[f"{instance}.{name}[{i}]"]] for i in range(1, n + 1)])
+
+    def motion(self, body: str, name: str, n: int | None = None) -> np.ndarray:
         """(n_times, n) array of a body's dynamics output ``name[1..n]`` (``position``,
-        ``attitude``, ``velocity``, ``acceleration``; global axes, SI), wherever the body's
-        dynamics FMU is."""
-        instance, prefix = self.dynamics[body]
+        ``attitude``, ``velocity``, ``acceleration``; global axes, SI: m, rad, m/s, rad/s,
+        m/s2, rad/s2), wherever the body's dynamics FMU is; ``n`` defaults to every
+        component (3 for position and attitude, 6 for velocity and acceleration)."""
+        dynamics = self.layout()[0]["dynamics"]
+        if body not in dynamics:
+            raise UnknownName("body", body, dynamics)
+        instance, prefix = dynamics[body]
         return self.vector(instance, f"{prefix}{name}", n)
+
+    def layout(self):
+        """(manifest, notes): the built scene's manifest, or without one (a CSV read on its
+        own) what the column names tell: each body's dynamics (``<body>_dynamics.position``,
+        or ``<group>_dynamics.<body>.position``) and its load FMU (instance ``<body>``)."""
+        if self.manifest is not None:
+            return self.manifest, []
+        dynamics = {}
+        if self.dynamics:
+            dynamics = dict(self.dynamics)
+        else:
+            for c in self.columns:
+                m = DYNAMICS.match(c)
+                if m:
+                    body = m["body"] or m["instance"][:-len("_dynamics")]
+                    dynamics[body] = [m["instance"], f"{m['body']}." if m["body"] else ""]
+        instances = {b: {"kind": "load", "body": b} for b in dynamics if f"{b}.force[1]" in self._index}
+        notes = ["no manifest: joint forces left out of the loads (read_csv(path, manifest=FOLDER) adds them)"]
+        return {"scene": "", "dynamics": dynamics, "instances": instances, "connections": []}, notes
 
     def unit(self, column: str) -> str:
         """The unit of a column (``''`` when the FMU declares none)."""
         return "s" if column == "time" else self.units.get(column, "")
 
+    def summary(self, transient: float = 0.0):
+        """Per body and dof: mean, std, min, max of its motion (position [m], attitude
+        [rad]) and of each load on it and their total [N, N.m], over t ≥ ``transient`` [s].
+        Returns a `cosim.summary.Summary` (``print`` it, ``to_json``, ``to_pandas``)."""
+        from .summary import summarize
+        return summarize(self, transient)
+
+    def to_pandas(self):
+        """A pandas DataFrame: time [s] as the index, one column per recorded variable;
+        ``df.attrs['units']`` maps each column (and ``'time'``) to its unit, ``attrs``
+        also holds the scene, algorithm, step and run settings.  Needs pandas (the
+        ``batch`` extra)."""
+        try:
+            import pandas as pd
+        except ImportError as exc:
+            raise ImportError(f"Result.to_pandas needs pandas (pip install 'hydrofmu[batch]'): {exc}") from None
+        df = pd.DataFrame(self.values, index=pd.Index(self.time, name="time"), columns=list(self.columns))
+        df.attrs.update({"units": {"time": "s", **{c: self.unit(c) for c in self.columns}},
+                         "scene": (self.manifest or {}).get("scene"), "algorithm": self.algorithm,
+                         "step": self.step, "settings": self.settings})
+        return df
+
     def to_csv(self, path) -> Path:
-        """Write the run as CSV, headers with units (``time [s]``, ``barge.force[1] [N]``);
-        returns the path.  Values are written with full precision (``repr``)."""
+        """Write the run as CSV, headers with units (``time [s]``, ``barge.force[1] [N]``,
+        attitude in rad); returns the path.  Values are written with full precision
+        (``repr``).  The file appears whole or not at all; a missing folder is an
+        InputError naming it (another failure to write, an OSError)."""
         path = Path(path)
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow([f"{c} [{self.unit(c) or '-'}]" for c in ["time"] + self.columns])
-            for t, row in zip(self.time, self.values):
-                w.writerow([repr(float(t))] + [repr(float(x)) for x in row])
+        if not path.parent.is_dir():
+            raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
+        tmp = path.with_name(f".{path.name}.tmp")
+        try:
+            with open(tmp, "w", newline="") as f:
+                w = csv.writer(f)
+                w.writerow([f"{c} [{self.unit(c) or '-'}]" for c in ["time"] + self.columns])
+                for t, row in zip(self.time, self.values):
+                    w.writerow([repr(float(t))] + [repr(float(x)) for x in row])
+            tmp.replace(path)
+        finally:   # a failed write leaves nothing (the OSError goes on: writable.keep may try elsewhere)
+            tmp.unlink(missing_ok=True)
         return path
 
     def plot(self, path) -> Path:
         """Write the PNG of ``cosim.report.plot`` (needs ``manifest``); returns the path."""
         from .report import plot
         if self.manifest is None:
-            raise ValueError("this Result has no manifest: plot it with cosim.report.plot(result, manifest, path)")
+            raise ValueError("this Result has no manifest, which the plot needs (which FMU is which body's "
+                             "load, joint or dynamics): read the CSV with read_csv(path, manifest=BUILT_FOLDER)")
+        path = Path(path)
+        if not path.parent.is_dir():
+            raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
         plot(self, self.manifest, path)
-        return Path(path)
+        return path
 
 
 def split_header(cell: str):
@@ -110,21 +213,44 @@ def read_csv(path, manifest=None) -> Result:
     path : str or Path
         The CSV file.
     manifest : str, Path or dict, optional
-        The built scene's ``manifest.json`` (or its folder), for ``Result.motion`` and
-        ``Result.plot``.  By default the manifest of ``<csv stem>/`` next to the CSV, if
-        there is one (where ``hydrofmu run`` writes it).
+        The built scene's ``manifest.json`` (or its folder).  By default the manifest of
+        ``<csv stem>/`` next to the CSV, if there is one (where ``hydrofmu run`` writes
+        it).  Without one the Result has the plain columns: ``r[column]``, ``vector``,
+        ``motion`` (each body's dynamics found from the column names), ``summary``
+        (without the joints' forces) and ``to_pandas`` work; ``plot`` needs it.
 
     Returns
     -------
     Result
-        With ``units`` from the header; ``algorithm`` and ``step`` from the manifest's
-        run settings when known (the step is also the spacing of the time column).
+        With ``units`` from the header; ``algorithm`` from the manifest's run settings
+        when known; ``step`` the spacing of the time column.
+
+    Raises
+    ------
+    hydrofmu.InputError
+        The file cannot be read, or a row is not numbers (file, line and column named).
     """
     path = Path(path)
-    with open(path, newline="") as f:
-        rows = csv.reader(f)
-        header = [split_header(c) for c in next(rows)]
-        data = np.array([[float(x) for x in row] for row in rows if row], dtype=float).reshape(-1, len(header))
+    try:
+        with open(path, newline="") as f:
+            rows = csv.reader(f)
+            header = [split_header(c) for c in next(rows, [])]
+            data = []
+            for row in rows:
+                if not row:
+                    continue
+                if len(row) != len(header):
+                    raise InputError(path, rows.line_num, "row", f"{len(row)} values for {len(header)} columns")
+                try:
+                    data.append([float(x) for x in row])
+                except ValueError:
+                    bad = next(i for i, x in enumerate(row) if not _is_number(x))
+                    raise InputError(path, rows.line_num, header[bad][0], f"expected a number, found {row[bad]!r}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(path, None, "file", f"cannot read the CSV ({getattr(exc, 'strerror', None) or exc})") from None
+    if not header or header[0][0] != "time":
+        raise InputError(path, 1, "header", "expected a header row starting with 'time [s]' (a CSV of Result.to_csv)")
+    data = np.array(data, dtype=float).reshape(-1, len(header))
     if manifest is None and (path.with_suffix("") / "manifest.json").is_file():
         manifest = path.with_suffix("")
     if isinstance(manifest, (str, Path)):
@@ -135,6 +261,14 @@ def read_csv(path, manifest=None) -> Result:
     run = (manifest or {}).get("run", {})
     return Result(data[:, 0].copy(), names, data[:, 1:].copy(), run.get("algorithm", ""), step,
                   (manifest or {}).get("dynamics"), None, {n: u for n, u in header[1:] if u}, manifest)
+
+
+def _is_number(text):
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
 
 
 def fmu_units(fmu) -> dict:

@@ -218,10 +218,11 @@ def input_starts(slaves, conns):
     return out
 
 
-def manifest(scene, system, conns):
+def manifest(scene, system, conns, inputs=None):
     """What our masters read (manifest.json): instances, routes, run settings, connections
-    and the power bonds (fmi.osp.scalar_bonds)."""
-    return {
+    and the power bonds (fmi.osp.scalar_bonds); ``inputs``: the hash of the scene file, its
+    decks and hydrofmu's sources the build came from (``api.inputs_hash``), when known."""
+    return {"inputs": inputs,
         "scene": scene.name, "source": str(scene.path), "run": scene.run,
         "instances": {i.name: {"fmu": f"{i.model_id}.fmu", "kind": i.kind, "body": i.body}
                       for i in system.instances},
@@ -254,10 +255,11 @@ def report_bem(scene, log, folder):
         log(f"  wrote {png.name}")
 
 
-def build_scene(scene, outdir, shim=True, log=print, check=False):
+def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None):
     """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
     The folder is replaced only when the whole build succeeded.  ``check``: stop before
-    anything is written (every check of the build done), return None."""
+    anything is written (every check of the build done), return None.  ``inputs``: recorded
+    in the manifest (see `manifest`)."""
     outdir = Path(outdir)
     target = outdir / scene.name
     system = assemble(scene)
@@ -272,7 +274,7 @@ def build_scene(scene, outdir, shim=True, log=print, check=False):
     created = next((p for p in [outdir, *outdir.parents][::-1] if not p.exists()), None)
     try:
         outdir.mkdir(parents=True, exist_ok=True)
-        _build_into(scene, outdir, target, system, runtime, shim, log)
+        _build_into(scene, outdir, target, system, runtime, shim, log, inputs)
     except OSError as exc:
         raise InputError(exc.filename or outdir, None, "output folder", f"cannot write ({exc.strerror})") from None
     finally:
@@ -281,7 +283,7 @@ def build_scene(scene, outdir, shim=True, log=print, check=False):
     return target
 
 
-def _build_into(scene, outdir, target, system, runtime, shim, log):
+def _build_into(scene, outdir, target, system, runtime, shim, log, inputs=None):
     with tempfile.TemporaryDirectory(prefix=f".{scene.name}-", dir=outdir) as tmp:
         work = Path(tmp)
         slaves, t0 = {}, {}
@@ -295,7 +297,7 @@ def _build_into(scene, outdir, target, system, runtime, shim, log):
         bonds = osp.bonds(system)
         result = work / "fmus"
         report_bem(scene, log, result)
-        (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns), indent=2))
+        (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns, inputs), indent=2))
         for model_id, text in osp.model_descriptions(system, slaves, bonds).items():
             (result / f"{model_id}_OspModelDescription.xml").write_bytes(text)
         (result / "OspSystemStructure.xml").write_text(
