@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError, InputWarning
+from . import keys as file_keys
 from .names import did_you_mean, unknown
 from .textfile import read_toml
 from .writable import check_folder
@@ -50,7 +51,7 @@ RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorit
 EXPOSED = {"environment.current_speed": "current.speed", "environment.current_direction": "current.direction",
            "environment.rho": "rho", "environment.g": "g"}
 STATS = ("max", "min", "mean", "std", "final")
-FILE_KEYS = {"scene", "outputs", "stop", "step", "algorithm", "transient", "series", "set", "matrix", "cases"}
+FILE_KEYS = file_keys.names(file_keys.CASES)
 SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import admissible
+from . import admissible, keys
 from .description import Effect, HydroCoupling, Kernel
 from .errors import InputError, InputWarning
 from .names import did_you_mean
@@ -257,12 +257,12 @@ def _from_deck(problems, table, where, reader, name_key, units=False):
 def _aqwa_viscous_drag(problems, table, where):
     from .decks.aqwa import read_viscous_drag
     if "deck" in table:
-        problems.known_keys(table, where, {"type", "name", "deck", "body"})
+        problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", True))
         data, _ = _from_deck(problems, table, where, read_viscous_drag, "body")
         if data is None:
             return None
         return {"matrix": np.asarray(data.matrix).tolist(), "relative": data.option == "RELATIVE"}
-    problems.known_keys(table, where, {"type", "name", "matrix", "option"})
+    problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", False))
     matrix = problems.matrix(table, "matrix", f"{where}.matrix", 6)
     option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
     if matrix is None or option is None:
@@ -277,10 +277,10 @@ def _deeplines_current_polar(problems, table, where):
     from .physics.current_polar import expand_polar
     symmetry = problems.choice(table, "symmetry", f"{where}.symmetry", ("none", "xz", "yz", "xz+yz"), "none")
     if "deck" in table:
-        problems.known_keys(table, where, {"type", "name", "deck", "structure", "symmetry"})
+        problems.known_keys(table, where, keys.effect_keys("deeplines_current_polar", True))
         data, _ = _from_deck(problems, table, where, read_current_polars, "structure")
     else:
-        problems.known_keys(table, where, {"type", "name", "point", "surface", "table", "symmetry"})
+        problems.known_keys(table, where, keys.effect_keys("deeplines_current_polar", False))
         point = problems.vector(table, "point", f"{where}.point", 3)
         surface = problems.number(table, "surface", f"{where}.surface", positive=True)
         raw = table.get("table")
@@ -306,7 +306,7 @@ def _deeplines_current_polar(problems, table, where):
             "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
 
 
-LUMPED_KEYS = {"am", "ae", "icoo", "cd", "added_mass"}
+LUMPED_KEYS = keys.names(keys.LUMPED)
 
 
 def _lumped_data(problems, table, where, kind):
@@ -344,8 +344,7 @@ def _lumped_data(problems, table, where, kind):
 
 
 def _riflex_body(problems, table, where):
-    keys = {"type", "name", "offset"} | ({"deck", "component", "units"} if "deck" in table else LUMPED_KEYS)
-    problems.known_keys(table, where, keys)
+    problems.known_keys(table, where, keys.effect_keys("riflex_body", "deck" in table))
     offset = problems.vector(table, "offset", f"{where}.offset", 3)
     data, _ = _lumped_data(problems, table, where, "BODY")
     if data is None or offset is None:
@@ -390,7 +389,7 @@ PRESETS = {
 def _ecco(p, run, base, step):
     """The ECCO settings of ``[run.ecco]`` over the preset's (or the defaults), checked."""
     table = p.table(run, "ecco", "run.ecco", required=False) or {}
-    p.known_keys(table, "run.ecco", set(ECCO_DEFAULTS))
+    p.known_keys(table, "run.ecco", keys.names(keys.ECCO))
     out = {k: p.number(table, k, f"run.ecco.{k}", v, positive=True)
            for k, v in base.get("ecco", ECCO_DEFAULTS).items()}
     if None in out.values():
@@ -410,7 +409,7 @@ def _ecco(p, run, base, step):
     return out
 
 
-COUPLING_KEYS = {"deck", "coupling", "bodies", "method", "tolerance", "order", "memory_length", "units"}
+COUPLING_KEYS = keys.names(keys.COUPLING)
 
 
 def _memory_knobs(problems, table, where, memory):
@@ -485,8 +484,7 @@ def _coupling(name, a, b, d, knobs, bem=None):
                          method, tol, order, length, set_, bem=bem)
 
 
-BEM_KEYS = {"bem", "bodies", "name", "dofs", "ulen", "timdel", "kernel_length", "symmetry_tolerance", "a_inf",
-            "rotation_centers", "method", "tolerance", "order", "memory_length"}
+BEM_KEYS = keys.names(keys.BEM_COUPLING)
 CENTRE_TOL = 0.01   # m: BEM rotation centres vs scene reference points
 
 
@@ -574,8 +572,7 @@ def _check_centres(data, mapping, bodies):
                              f"{shift[:2].tolist()} m); the coefficients must be about the reference point")
 
 
-JOINT_KEYS = {"type", "a", "a_point", "b", "b_point", "stiffness", "damping", "rot_stiffness",
-              "rot_damping", "acceleration_loads"}
+JOINT_KEYS = keys.names(keys.JOINT)
 
 
 @dataclass
@@ -599,8 +596,7 @@ class Joint:
 
 
 def _joint(problems, name, table, where, bodies):
-    keys = JOINT_KEYS | ({"deck", "component", "units"} if "deck" in table else LUMPED_KEYS | {"codes"})
-    problems.known_keys(table, where, keys)
+    problems.known_keys(table, where, keys.joint_keys("deck" in table))
     if not identifier(name) or name in bodies or name.endswith("_dynamics"):
         problems.add(where, "joint name must be an identifier that is not a body's name")
     problems.choice(table, "type", f"{where}.type", ("riflex_conb",), "riflex_conb")
@@ -624,8 +620,7 @@ def _joint(problems, name, table, where, bodies):
         return None
     return Joint(name, a, None if b == "earth" else b, a_point, b_point, codes, node, accel_mode=mode, **optional)
 
-BODY_KEYS = {"position", "attitude", "velocity", "mass", "inertia", "cog", "stiffness", "damping",
-             "acceleration_loads", "effects"}
+BODY_KEYS = keys.names(keys.BODY)
 def _body(problems, name, table, where):
     problems.known_keys(table, where, BODY_KEYS)
     if not identifier(name):
@@ -702,17 +697,16 @@ def _load_scene(path, overrides=None):
     for key, value in (overrides or {}).items():
         override(doc, key, value, path)
     p = Problems(path)
-    p.known_keys(doc, "", {"scene", "environment", "run", "bodies", "joints", "couplings"})
+    p.known_keys(doc, "", keys.names(keys.SCENE))
     meta = p.table(doc, "scene", "scene", required=False) or {}
-    p.known_keys(meta, "scene", {"name", "description"})
+    p.known_keys(meta, "scene", keys.names(keys.SCENE_META))
     name = meta.get("name", path.stem)
     if not isinstance(name, str) or not identifier(name):
         p.add("scene.name", f"scene name must be an identifier, found {name!r}")
     env = p.table(doc, "environment", "environment", required=False) or {}
-    p.known_keys(env, "environment", {"rho", "g", "current_speed", "current_direction", "current_profile",
-                                      "current_deck", *CURRENT_DECK_KEYS})
+    p.known_keys(env, "environment", keys.names(keys.ENVIRONMENT))
     run = p.table(doc, "run", "run", required=False) or {}
-    p.known_keys(run, "run", set(RUN_DEFAULTS) | {"preset", "ecco"})
+    p.known_keys(run, "run", keys.names(keys.RUN))
     preset = run.get("preset")
     if preset is not None and preset not in PRESETS:
         p.add("run.preset", f"expected one of {', '.join(map(repr, PRESETS))}, found {preset!r}")
@@ -769,7 +763,7 @@ def _load_scene(path, overrides=None):
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
 CURRENT_FORMATS = ("deeplines", "sima", "riflex")
 # keys that go with current_deck; the last three only with current_format = "riflex"
-CURRENT_DECK_KEYS = ("current_format", "current_environment", "current_state", "current_units")
+CURRENT_DECK_KEYS = tuple(keys.CURRENT_DECK)
 
 
 def _current(problems, env):

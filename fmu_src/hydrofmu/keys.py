@@ -1,0 +1,216 @@
+"""The keys of scene files and case files: every table, its keys, each key's type and meaning.
+
+This is the one place that defines them.  ``scene.py`` and ``batch.py`` accept exactly these
+keys (an unknown one is an error naming the closest, `scene.Problems.known_keys`), and
+``schema.py`` turns them into the JSON Schema shipped with the package
+(``hydrofmu/schema/scene.schema.json``, ``cases.schema.json``), which TOML editors (taplo,
+Even Better TOML) use to complete keys and flag mistakes while a file is typed.  A new key
+goes here first; the validator then still checks its value.
+
+Each key maps to ``(schema, description)``: ``schema`` a JSON Schema fragment for its value
+(the shape a TOML editor can check; the validator's checks go further: finite numbers,
+positive definite inertia, decks that exist…), ``description`` one line with its unit.
+"""
+NUMBER = {"type": "number"}
+POSITIVE = {"type": "number", "exclusiveMinimum": 0}
+NONNEG = {"type": "number", "minimum": 0}
+STRING = {"type": "string", "minLength": 1}
+NAME = {"type": "string", "pattern": "^[A-Za-z][A-Za-z0-9_]*$"}
+
+
+def vector(n):
+    return {"type": "array", "items": NUMBER, "minItems": n, "maxItems": n}
+
+
+def matrix(n):
+    """n values (the diagonal) or n×n."""
+    return {"oneOf": [vector(n), {"type": "array", "items": vector(n), "minItems": n, "maxItems": n}]}
+
+
+def enum(*values):
+    return {"enum": list(values)}
+
+
+ROWS = {"type": "array", "items": {"type": "array", "items": NUMBER}}
+NAMES = {"type": "array", "items": STRING}
+BODY_MAP = {"type": "object", "additionalProperties": STRING}
+UNITS = ("units", enum("SI", "Mg-kN", "kg-kN"), "unit system of a SIMO/RIFLEX file (checked against its declaration)")
+
+SCENE_META = {
+    "name": (NAME, "identifier; FMU model identifiers are <scene>_<body> (default: the file name)"),
+    "description": ({"type": "string"}, "free text"),
+}
+
+CURRENT_DECK = {
+    "current_format": (enum("deeplines", "sima", "riflex"), "format of current_deck"),
+    "current_environment": (STRING, "RIFLEX only: IDENV of the environment in the INPMOD file"),
+    "current_state": ({"type": "integer", "minimum": 1}, "RIFLEX only: ICUSTA of the current state"),
+    "current_units": (UNITS[1], "RIFLEX only: the file's unit system"),
+}
+
+ENVIRONMENT = {
+    "rho": (POSITIVE, "water density [kg/m3] (default 1025)"),
+    "g": (POSITIVE, "gravity [m/s2] (default 9.81)"),
+    "current_speed": (NONNEG, "current speed [m/s], start value of the FMU input current.speed"),
+    "current_direction": (NUMBER, "current direction [deg], going to, counter-clockwise from +x"),
+    "current_profile": (ROWS, "[[z m, speed m/s, direction deg], …], z ≤ 0, strictly ordered"),
+    "current_deck": (STRING, "current profile file, relative to the scene (with current_format)"),
+    **CURRENT_DECK,
+}
+
+ECCO = {
+    "rel_tolerance": (POSITIVE, "residual energy per step relative to the energy the bonds carry"),
+    "abs_tolerance": (POSITIVE, "residual energy per step [J]"),
+    "min_step": (POSITIVE, "smallest step [s]"),
+    "max_step": (POSITIVE, "largest step [s]"),
+    "safety_factor": (POSITIVE, "PI controller's safety factor, in (0, 1]"),
+    "min_change_rate": (POSITIVE, "smallest step ratio, in (0, 1]"),
+    "max_change_rate": (POSITIVE, "largest step ratio, ≥ 1"),
+    "p_gain": (POSITIVE, "PI controller's proportional gain"),
+    "i_gain": (POSITIVE, "PI controller's integral gain"),
+}
+
+RUN = {
+    "preset": (enum("screening", "design", "reference", "adaptive"), "speed/accuracy preset: sets the knobs below"),
+    "step": (POSITIVE, "communication step [s] (ECCO: the first step)"),
+    "stop": (POSITIVE, "end time [s], a whole number of steps"),
+    "algorithm": (enum("jacobi", "gauss-seidel", "ecco"), "master algorithm"),
+    "substep": (POSITIVE, "accuracy of the dynamics partner [s]: internal steps ≤ 5·substep"),
+    "load_hold": (enum("constant", "linear"), "how the dynamics hold a load input over a step"),
+    "ecco": ({"table": ECCO}, "libcosim's ECCO settings (algorithm = \"ecco\")"),
+}
+
+LUMPED = {
+    "am": (NONNEG, "mass [kg]"),
+    "ae": (NONNEG, "volume [m3] (buoyancy ρ·g·AE)"),
+    "icoo": (enum("GLOBAL", "LOCAL"), "axes of the drag and added-mass coefficients"),
+    "cd": (vector(3), "quadratic drag [N/(m/s)2] per axis"),
+    "added_mass": (vector(3), "added mass [kg] per axis"),
+}
+COMPONENT = {
+    "deck": (STRING, "RIFLEX input file, relative to the scene"),
+    "component": (STRING, "CMPTYP-ID of the component"),
+    UNITS[0]: UNITS[1:],
+}
+EFFECT_COMMON = {
+    "type": (STRING, "effect type"),
+    "name": (NAME, "effect name: its loads are <name>.force[1..6] (default per type)"),
+}
+
+# effect type -> {"deck": keys when the data come from a deck, "inline": keys otherwise}
+EFFECTS = {
+    "aqwa_viscous_drag": {
+        "deck": {"deck": (STRING, "AQWA input file, relative to the scene"),
+                 "body": (STRING, "FLOATING BODY name in the deck")},
+        "inline": {"matrix": (matrix(6), "6×6 drag matrix V (or 6 diagonal values), body axes"),
+                   "option": (enum("ABSOLUTE", "RELATIVE"), "RELATIVE: velocity relative to the current")},
+    },
+    "deeplines_current_polar": {
+        "deck": {"deck": (STRING, "DeepLines data file, relative to the scene"),
+                 "structure": (STRING, "*CURRENTPOL,NAME= of the structure"),
+                 "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+        "inline": {"point": (vector(3), "current centre (XC, YC, ZC) [m], body axes"),
+                   "surface": (POSITIVE, "reference surface SURFC [m2]"),
+                   "table": (ROWS, "[[angle deg, CX, CY, CMZ m], …]"),
+                   "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+    },
+    "riflex_body": {
+        "deck": {"offset": (vector(3), "attachment point [m], body axes from the reference point"), **COMPONENT},
+        "inline": {"offset": (vector(3), "attachment point [m], body axes from the reference point"), **LUMPED},
+    },
+}
+
+BODY = {
+    "position": (vector(3), "initial (equilibrium) position of the reference point [m], global"),
+    "attitude": (vector(3), "initial roll, pitch, yaw [rad]"),
+    "velocity": (vector(6), "initial velocity [m/s, rad/s], global axes"),
+    "mass": (POSITIVE, "mass [kg]"),
+    "inertia": (matrix(3), "inertia about the CoG [kg m2], body axes (3 values = diagonal, or 3×3)"),
+    "cog": (vector(3), "centre of gravity [m], body axes from the reference point"),
+    "stiffness": (matrix(6), "6×6 stiffness (or 6 diagonal values) [N/m, N m/rad]"),
+    "damping": (matrix(6), "6×6 linear damping (or 6 diagonal values) [N s/m, N m s/rad]"),
+    "acceleration_loads": (enum("export", "explicit"), "acceleration loads exported as added mass, or applied"),
+    "effects": ({"effects": EFFECTS}, "the body's load effects ([[bodies.NAME.effects]])"),
+}
+
+JOINT = {
+    "type": (enum("riflex_conb"), "joint type"),
+    "a": (STRING, "side A: a body"),
+    "a_point": (vector(3), "joint point [m] in A's body axes"),
+    "b": (STRING, "side B: a body or \"earth\""),
+    "b_point": (vector(3), "joint point [m] in B's body axes (global for the earth)"),
+    "stiffness": (POSITIVE, "translational spring [N/m] (default from the step)"),
+    "damping": (NONNEG, "translational damper [N s/m] (default from the step)"),
+    "rot_stiffness": (POSITIVE, "rotational spring [N m/rad] (default from the step)"),
+    "rot_damping": (NONNEG, "rotational damper [N m s/rad] (default from the step)"),
+    "acceleration_loads": (enum("export", "explicit"), "of the joint node's mass (goes to side A)"),
+}
+JOINT_DECK = dict(COMPONENT)
+JOINT_INLINE = {**LUMPED, "codes": (vector(3), "freedom codes IRX IRY IRZ: 0 free, 1 fixed")}
+
+MEMORY = {
+    "method": (enum("convolution", "state_space"), "memory evaluator"),
+    "tolerance": (POSITIVE, "state space: fit tolerance (normalised RMS)"),
+    "order": ({"type": "integer", "minimum": 1}, "state space: order per kernel instead of a tolerance"),
+    "memory_length": (POSITIVE, "truncate the kernels [s]"),
+}
+COUPLING = {
+    "deck": (STRING, "SIMO system file, relative to the scene"),
+    "coupling": (STRING, "CHCPL of the HYDRodynamic COUPling DATA group"),
+    "bodies": (BODY_MAP, "SIMO body -> scene body (default: same name)"),
+    UNITS[0]: UNITS[1:],
+    **MEMORY,
+}
+BEM_COUPLING = {
+    "bem": (STRING, "Capytaine dataset (.nc) or WAMIT .1 file, relative to the scene"),
+    "bodies": (BODY_MAP, "BEM body -> scene body (WAMIT: body1, body2, …)"),
+    "name": (NAME, "prefix of the couplings' names (default \"bem\")"),
+    "dofs": (NAMES, "dofs to keep, e.g. [\"Surge\", \"Heave\", \"Pitch\"] (default: all)"),
+    "ulen": (POSITIVE, "WAMIT: the length ULEN [m]"),
+    "timdel": (POSITIVE, "kernel spacing [s] (default from the grid)"),
+    "kernel_length": (POSITIVE, "kernel length [s] (default from the grid)"),
+    "symmetry_tolerance": (POSITIVE, "A∞ asymmetry allowed, relative to √(A_ii·A_jj)"),
+    "a_inf": (enum("ogilvie", "file"), "A∞ consistent with the kernels (Ogilvie), or the file's ω = ∞ row"),
+    "rotation_centers": ({"type": "object", "additionalProperties": vector(3)},
+                         "declared rotation centre per BEM body [m] (WAMIT's XBODY)"),
+    **MEMORY,
+}
+
+SCENE = {
+    "scene": ({"table": SCENE_META}, "name and description"),
+    "environment": ({"table": ENVIRONMENT}, "water, gravity and current"),
+    "run": ({"table": RUN}, "run settings (hydrofmu run, demo)"),
+    "bodies": ({"map": BODY}, "one table per floating body: [bodies.NAME]"),
+    "joints": ({"map": JOINT, "variants": {"deck": JOINT_DECK, "inline": JOINT_INLINE}},
+               "RIFLEX CONB joints: [joints.NAME]"),
+    "couplings": ({"couplings": (COUPLING, BEM_COUPLING)},
+                  "SIMO hydrodynamic couplings ([[couplings]]: deck + coupling, or bem)"),
+}
+
+CASES = {
+    "scene": (STRING, "the scene file, or a built scene folder, relative to this file"),
+    "outputs": (NAMES, "'instance.variable' outputs whose statistics the table holds"),
+    "stop": (POSITIVE, "end time of every case [s]"),
+    "step": (POSITIVE, "communication step of every case [s]"),
+    "algorithm": (enum("jacobi", "gauss-seidel", "ecco"), "master algorithm of every case"),
+    "transient": (NONNEG, "statistics leave out t < transient [s]"),
+    "series": ({"type": "boolean"}, "write each case's time series"),
+    "set": ({"type": "object"}, "knobs of every case: {\"key.path\" = value}"),
+    "matrix": ({"type": "object", "additionalProperties": {"type": "array", "minItems": 1}},
+               "the cases are the cross product: {\"key.path\" = [values]}"),
+    "cases": ({"type": "array", "items": {"type": "object"}}, "single cases after the matrix ones"),
+}
+
+
+def names(table):
+    """The set of keys of a table above (``ENVIRONMENT``, ``RUN``, …)."""
+    return set(table)
+
+
+def effect_keys(kind, from_deck):
+    """The keys an effect of type ``kind`` takes, with its data from a deck or inline."""
+    return set(EFFECT_COMMON) | set(EFFECTS[kind]["deck" if from_deck else "inline"])
+
+
+def joint_keys(from_deck):
+    return set(JOINT) | set(JOINT_DECK if from_deck else JOINT_INLINE)
