@@ -125,3 +125,32 @@ def test_floor_spread_and_linearity_bookkeeping():
     marginal, ratio = floor.linearity(rows, [3, 10, 36])
     assert marginal == pytest.approx([60 / 7, 240 / 26])
     assert ratio == pytest.approx((240 / 26) / (60 / 7))
+
+
+def test_bench_lines_never_contradict_their_numbers():
+    """No negative overhead, no 'spread 25 % > 25 %', no comparison of nothing with nothing:
+    where a figure is noise the line says so instead of printing it."""
+    import re
+    from hydrofmu.bench.run import batch_lines, overhead_line, pool_line
+    from hydrofmu.bench.timing import over
+    for spread in (0.2500001, 0.2504, 0.251, 0.26, 0.9):
+        shown, limit = map(float, re.match(r"spread ([\d.]+) % > ([\d.]+) %", over(spread, 0.25)).groups())
+        assert shown > limit
+    quiet = {"spread": 0.1, "noisy": False, "speedup": 1.8, "case_s": 0.2, "fixed_s": 0.3}
+    lines = batch_lines({**quiet, "overhead_s": -0.029, "share": -0.128}, 4)
+    assert not re.search(r"−|-\d", " ".join(lines)) and "below the noise" in lines[1] and "1.80×" in lines[0]
+    assert "2 ms = 1.0 %" in batch_lines({**quiet, "overhead_s": 0.002, "share": 0.01}, 4)[1]
+    noisy = batch_lines({**quiet, "noisy": True, "spread": 0.4, "overhead_s": 0.002, "share": 0.01}, 4)
+    assert "1.80" not in noisy[0] and "too noisy" in noisy[0] and "2 ms" not in noisy[1]
+    flat = {"growth_kB": 0.0, "rss_kB": [1e5, 1e5], "kB_per_cycle": 0.0, "cycle_s": 2e-3}
+    line = pool_line(flat, flat, 500, 200)
+    assert "too few cycles" in line and "against" not in line
+    leak = {**flat, "growth_kB": 560.0, "kB_per_cycle": 1.12, "rss_kB": [1e5, 1e5 + 560]}
+    assert "0 kB (0.000 kB per cycle; steady part 0 kB: flat) with" in pool_line(flat, leak, 500, 200)
+    row = {"coupling_method": "state_space", "fmu_us": 1360.0, "in_process_us": 1385.0, "ratio": 0.98,
+           "floor_us": 40.0, "ratio_above_floor": 0.95, "spread": 0.1, "noisy": False}
+    assert "no figure" in overhead_line(row) and "0.98×" not in overhead_line(row)
+    assert "too noisy (spread 46 % > 25 % between rounds), no figure" in overhead_line({**row, "noisy": True, "spread": 0.46})
+    good = overhead_line({**row, "fmu_us": 37.0, "in_process_us": 23.0, "ratio": 1.6, "floor_us": 13.0,
+                          "ratio_above_floor": -0.02})
+    assert "1.60×" in good and "within the noise" in good and "-0.02" not in good

@@ -17,7 +17,7 @@ from ..decks.simo import format_coupling, write_couplings
 from ..assembly import body_loads
 from ..physics.state import Env, Motion
 from .kernels import coupling_kernels, irregular_velocity
-from .timing import per_call
+from .timing import per_round
 
 TIMDEL = 0.05
 
@@ -90,14 +90,15 @@ def motions(n, dt):
 
 
 def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIMDEL):
-    """Seconds per step {'fmu', 'in_process', 'floor'} and the ratio FMU/in-process; builds
-    into ``folder``."""
+    """Seconds per step {'fmu', 'in_process', 'floor'} (medians of the rounds), the ratio
+    FMU/in-process (median of each round's ratio), its ``spread`` between rounds and
+    ``noisy`` (spread > floor.NOISY); builds into ``folder``."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
     from ..fmi.build import build_scene
     from ..scene import load_scene
-    from .floor import build_floor
+    from .floor import NOISY, build_floor, spread
 
     scene = load_scene(write_scene(folder, method, lags, dt))
     built = build_scene(scene, Path(folder) / "fmus", log=lambda *_: None)
@@ -156,9 +157,11 @@ def measure(folder, method="state_space", lags=400, steps=1000, rounds=5, dt=TIM
 
     slaves = []
     try:
-        cost = per_call({"fmu": fmu_run, "in_process": kernel_run, "floor": floor_run}, steps, rounds)
+        times = per_round({"fmu": fmu_run, "in_process": kernel_run, "floor": floor_run}, steps, rounds)
     finally:
         for slave in slaves:
             slave.terminate()
             slave.freeInstance()
-    return {**cost, "ratio": cost["fmu"] / cost["in_process"]}
+    ratios = np.array(times["fmu"]) / np.array(times["in_process"])
+    return {**{k: float(np.median(t)) for k, t in times.items()}, "ratio": float(np.median(ratios)),
+            "spread": spread(ratios), "noisy": spread(ratios) > NOISY}

@@ -35,6 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from . import cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust, stability  # noqa: E402
+from .timing import over  # noqa: E402
 
 
 def write_csv(path, rows):
@@ -49,21 +50,36 @@ def write_csv(path, rows):
 def part_overhead(out, quick):
     rows = []
     for method in ("state_space", "convolution"):
-        r = overhead.measure(out / f"overhead_{method}", method, steps=200 if quick else 1000,
-                             rounds=3 if quick else 5)
+        r = overhead.measure(out / f"overhead_{method}", method, lags=100 if quick else 400,
+                             steps=100 if quick else 1000, rounds=3 if quick else 5)
         rows.append({"coupling_method": method, "fmu_us": 1e6 * r["fmu"], "in_process_us": 1e6 * r["in_process"],
                      "ratio": r["ratio"], "floor_us": 1e6 * r["floor"],
-                     "ratio_above_floor": (r["fmu"] - r["floor"]) / r["in_process"]})
+                     "ratio_above_floor": (r["fmu"] - r["floor"]) / r["in_process"],
+                     "spread": r["spread"], "noisy": r["noisy"]})
     write_csv(out / "overhead.csv", rows)
-    return [f"FMU overhead ({r['coupling_method']} memory): {r['ratio']:.2f}× "
-            f"({r['fmu_us']:.0f} µs vs {r['in_process_us']:.0f} µs per step; the pythonfmu floor under the same "
-            f"calls {r['floor_us']:.0f} µs, the FMU above it {r['ratio_above_floor']:.2f}× the kernels)" for r in rows]
+    return [overhead_line(r) for r in rows]
+
+
+def overhead_line(r):
+    """One line per overhead row: the figure, or why there is none.  The FMU runs the same
+    kernels plus the FMI calls, so it cannot be faster than them: a ratio below 1 (or below
+    the floor) is noise, said as such."""
+    head = f"FMU overhead ({r['coupling_method']} memory): "
+    times = f"{r['fmu_us']:.0f} µs vs {r['in_process_us']:.0f} µs per step in-process"
+    if r["noisy"]:
+        return head + f"too noisy ({over(r['spread'], floor.NOISY)} between rounds), no figure ({times})"
+    if r["ratio"] < 1.0:
+        return head + f"below the noise: the FMU measured no slower than its kernels ({times}), no figure"
+    above = (f"the FMU above it {r['ratio_above_floor']:.2f}× the kernels" if r["ratio_above_floor"] > 0 else
+             "the FMU above it within the noise")
+    return head + f"{r['ratio']:.2f}× ({times}; the pythonfmu floor under the same calls {r['floor_us']:.0f} µs, {above})"
 
 
 def part_memory(out, quick):
-    size = dict(lags=400 if quick else 2000, duration=60.0 if quick else 300.0,
-                calls=100 if quick else 400, rounds=3 if quick else 5)
-    rows = memory_cost.tradeoff(**size)
+    size = dict(lags=200 if quick else 2000, duration=20.0 if quick else 300.0,
+                calls=50 if quick else 400, rounds=3 if quick else 5)
+    knobs = dict(lengths=(5.0,), tolerances=(0.03, 0.01), orders=(2,)) if quick else {}
+    rows = memory_cost.tradeoff(**size, **knobs)
     # the same at half the kernel's sample spacing (co-simulation steps are often finer)
     half = memory_cost.tradeoff(**size, lengths=(), tolerances=(0.01,), orders=(), dt=0.025)
     write_csv(out / "memory_tradeoff.csv", rows + half)
@@ -115,8 +131,8 @@ def plot_memory_tradeoff(rows, path):
 
 def part_sweep(out, quick):
     from . import ecco_cost
-    steps = (0.2, 0.1, 0.05) if quick else (0.2, 0.1, 0.05, 0.02, 0.01)
-    stop = 20.0 if quick else 60.0
+    steps = (0.2, 0.1) if quick else (0.2, 0.1, 0.05, 0.02, 0.01)
+    stop = 10.0 if quick else 60.0
     rows = cosim_cost.step_sweep(out / "sweep", steps=steps, stop=stop)
     # libcosim's ECCO on the same scene (adaptive step), one point per energy tolerance
     rows = cosim_cost.pareto([{**r, "tolerance": ""} for r in rows]
@@ -154,10 +170,10 @@ def part_sweep(out, quick):
 
 def part_ecco(out, quick):
     from . import ecco_cost
-    rows, traces = ecco_cost.measure(out / "ecco", stop=20.0 if quick else 60.0,
-                                     steps=(0.1, 0.05) if quick else (0.1, 0.05, 0.02),
+    rows, traces = ecco_cost.measure(out / "ecco", stop=10.0 if quick else 60.0,
+                                     steps=(0.1,) if quick else (0.1, 0.05, 0.02),
                                      tolerances=(1.0,) if quick else (10.0, 1.0, 0.1),
-                                     fine=0.01 if quick else 0.005)
+                                     fine=0.02 if quick else 0.005)
     rows = [r for case in dict.fromkeys(r["case"] for r in rows)
             for r in cosim_cost.pareto([r for r in rows if r["case"] == case], cost="steps")]
     write_csv(out / "ecco.csv", rows)
@@ -234,8 +250,8 @@ def plot_ecco_steps(traces, path):
 
 def part_growth(out, quick):
     lags = memory_cost.growth((100, 1000) if quick else (100, 300, 1000, 3000, 10000),
-                              calls=100 if quick else 300, rounds=3 if quick else 5)
-    flat = cosim_cost.flatness(out / "flat", stop=100.0 if quick else 1000.0, chunks=5 if quick else 10)
+                              calls=50 if quick else 300, rounds=3 if quick else 5)
+    flat = cosim_cost.flatness(out / "flat", stop=40.0 if quick else 1000.0, chunks=4 if quick else 10)
     write_csv(out / "growth_lags.csv", lags)
     write_csv(out / "growth_time.csv", flat)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4.5))
@@ -268,7 +284,7 @@ def part_floor(out, quick):
     for path in sorted(Path("models").glob("*.toml")):
         scene = load_scene(path)
         candidates[scene.name] = build_scene(scene, out / "floor" / "scenes", log=quiet)
-    counts = (2, 4) if quick else (2, 4, 8)
+    counts = (2,) if quick else (2, 4, 8)
     pairs = []
     for n in counts:
         fleet = Fleet(n)
@@ -277,16 +293,15 @@ def part_floor(out, quick):
         pairs.append(len(fleet.pairs()))
     # 2000 steps (100 s simulated): a loop of 400 (~0.1 s) varied by a third between rounds
     # even on a quiet machine, 2000 by a few per cent
-    rows = floor.compare(candidates, fmu, out / "floor", rounds=3 if quick else 5, steps=100 if quick else 2000,
+    rows = floor.compare(candidates, fmu, out / "floor", rounds=2 if quick else 5, steps=100 if quick else 2000,
                          best_of=1 if quick else floor.STARTUP_BEST)
     write_csv(out / "floor.csv", rows)
-    lines = [f"floor: {r['fmus']} trivial pythonfmu FMUs {r['step_floor_us']:.0f} µs per step, "
+    lines = [f"{r['fmus']} trivial pythonfmu FMUs (the reference): {r['step_floor_us']:.0f} µs per step, "
              f"startup {1e3 * r['startup_floor_s']:.0f} ms" for r in {r["fmus"]: r for r in rows}.values()]
 
     def figure(r, what, text):
         if r[f"{what}_noisy"]:
-            return (f"{what} too noisy (spread between rounds {100 * r[f'{what}_spread']:.0f} % > "
-                    f"{100 * floor.NOISY:.0f} %), no figure")
+            return f"{what} too noisy ({over(r[f'{what}_spread'], floor.NOISY)} between rounds), no figure"
         return text
 
     for r in rows:
@@ -319,14 +334,14 @@ def part_native(out, quick):
     from ..fmi.shim import install_shim
     # the floor with hydrofmu's shim, which starts Python in a host that has none
     fmus = {"pythonfmu_floor": install_shim(floor.build_floor(out / "native"))}
-    for name in ("moored_barge", "side_by_side"):
+    for name in ("moored_barge",) if quick else ("moored_barge", "side_by_side"):
         folder = build_scene(load_scene(Path("models") / f"{name}.toml"), out / "native" / "scenes", log=lambda *_: None)
         fmus.update({f.stem: f for f in sorted(folder.glob("*.fmu"))})
-    rows = native.compare(fmus, rounds=3 if quick else 5, steps=500 if quick else 10_000, work=out / "native")
+    rows = native.compare(fmus, rounds=2 if quick else 5, steps=500 if quick else 10_000, work=out / "native")
     write_csv(out / "native.csv", rows)
     lines = []
     for r in rows:
-        step = (f"too noisy per step (spread {100 * r['step_spread']:.0f} %)" if r["step_noisy"] else
+        step = (f"too noisy per step ({over(r['step_spread'], floor.NOISY)}), no figure" if r["step_noisy"] else
                 f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
                 f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
         lines.append(f"{r['label']}: {step}; startup {1e3 * r['startup_s']:.0f} ms native (Python started by "
@@ -335,57 +350,78 @@ def part_native(out, quick):
 
 
 def part_stability(out, quick):
-    csv_path, png = stability.run(out)
+    csv_path, png = stability.run(out, n_steps=100 if quick else 400)
     return [f"added-mass map: {csv_path.name}, {png.name}"]
 
 
 def part_bem(out, quick):
     sizes = ((12, 50), (12, 100)) if quick else ((12, 50), (12, 100), (12, 200), (24, 100))
-    rows = radiation_cost.measure(sizes, rounds=3 if quick else 5)
+    rows = radiation_cost.measure(sizes, rounds=2 if quick else 5)
     write_csv(out / "bem_transform.csv", rows)
     return [f"BEM transform, {r['dofs']} dofs × {r['frequencies']} frequencies: {r['seconds']:.2f} s "
             f"(×{r['ratio']:.2f} of the first)" for r in rows]
 
 
 def part_robust(out, quick):
-    r = robust.deck_error_time(out / "robust", 5.0 if quick else 50.0)
+    r = robust.deck_error_time(out / "robust", 2.0 if quick else 50.0)
     (out / "robust" / "big.sys").unlink()
     (out / "robust" / "bad_big.sys").unlink()
     from ..fmi.build import build_scene
     from ..scene import load_scene
     folder = build_scene(load_scene(Path("models") / "moored_barge.toml"),
                          out / "robust", log=lambda *_: None)
-    cycles = 2000 if quick else 10_000
+    cycles, warmup = (500, 200) if quick else (10_000, 1000)
     fmu = folder / "moored_barge_barge.fmu"
-    off = robust.instantiate_cycles(fmu, cycles, pool=False)   # side by side, pool off first
-    on = robust.instantiate_cycles(fmu, cycles)
+    off = robust.instantiate_cycles(fmu, cycles, warmup, pool=False)   # side by side, pool off first
+    on = robust.instantiate_cycles(fmu, cycles, warmup)
     rows = [{**{k: v for k, v in r.items() if k != "error"}, "pool": p, "cycles": c["cycles"],
              "growth_kB": c["growth_kB"], "steady_kB": robust.growth(c["rss_kB"])[0],
              "kB_per_cycle": c["kB_per_cycle"], "cycle_s": c["cycle_s"]} for p, c in (("off", off), ("on", on))]
     write_csv(out / "robust.csv", rows)
-    steady, total = robust.growth(on["rss_kB"])
-    flat = steady < robust.FLAT_KB and total < robust.ARENA_KB
     return [f"one bad number near the end of a {r['megabytes']:.0f} MB SIMO deck: reported in {r['bad_s']:.2f} s, "
             f"the good deck reads in {r['good_s']:.2f} s (ratio {r['ratio']:.2f}, best of 2, side by side)",
-            f"{cycles} fmi2Instantiate/fmi2FreeInstance cycles of a load FMU through fmpy after 1000 of warm-up, "
-            f"resident memory: {on['growth_kB']:.0f} kB ({on['kB_per_cycle']:.3f} kB per cycle; "
-            f"steady part {steady:.0f} kB: {'flat' if flat else 'NOT flat'}) "
-            f"with the shim's instance pool, {off['growth_kB']:.0f} kB ({off['kB_per_cycle']:.2f} kB per cycle) "
-            f"without (HYDROFMU_POOL=0); {1e3 * on['cycle_s']:.1f} ms against {1e3 * off['cycle_s']:.1f} ms "
-            f"per cycle (×{off['cycle_s'] / on['cycle_s']:.1f})"]
+            pool_line(on, off, cycles, warmup)]
+
+
+def pool_line(on, off, cycles, warmup=1000):
+    """The instance pool's memory figure: growth with and without it, compared only when
+    the run without it grew by more than the flatness bound (else the cycles were too few
+    to tell the two apart, and the line says so)."""
+    steady, total = robust.growth(on["rss_kB"])
+    flat = steady < robust.FLAT_KB and total < robust.ARENA_KB
+    head = f"{cycles} fmi2Instantiate/fmi2FreeInstance cycles of a load FMU through fmpy after {warmup} of warm-up: "
+    if off["growth_kB"] <= robust.FLAT_KB:
+        return head + (f"no growth to compare ({on['growth_kB']:.0f} kB with the shim's instance pool, "
+                       f"{off['growth_kB']:.0f} kB without; below the {robust.FLAT_KB} kB flatness bound): too few "
+                       f"cycles to measure the pool (the full run has 10⁴)")
+    return head + (f"resident memory {on['growth_kB']:.0f} kB ({on['kB_per_cycle']:.3f} kB per cycle; "
+                   f"steady part {steady:.0f} kB: {'flat' if flat else 'NOT flat'}) "
+                   f"with the shim's instance pool, {off['growth_kB']:.0f} kB ({off['kB_per_cycle']:.2f} kB per "
+                   f"cycle) without (HYDROFMU_POOL=0); {1e3 * on['cycle_s']:.1f} ms against "
+                   f"{1e3 * off['cycle_s']:.1f} ms per cycle (×{off['cycle_s'] / on['cycle_s']:.1f})")
 
 
 def part_batch(out, quick):
     from . import batch_cost
-    rows, s = batch_cost.measure(out / "batch", cases=4 if quick else 16, stop=10.0 if quick else 60.0,
+    rows, s = batch_cost.measure(out / "batch", cases=4 if quick else 16, stop=5.0 if quick else 60.0,
                                  rounds=2 if quick else 3)
     write_csv(out / "batch.csv", rows)
-    verdict = (f"too noisy (spread between rounds {100 * s['spread']:.0f} % > {100 * batch_cost.NOISY:.0f} %): "
-               "figures indicative only; " if s["noisy"] else "")
-    return [f"{verdict}speed-up 1 → 2 workers: {s['speedup']:.2f}× ({rows[0]['cases']} cases of "
-            f"{s['case_s']:.2f} s each on one worker)",
-            f"dispatch overhead per case: {1e3 * s['overhead_s']:.0f} ms = {100 * s['share']:.1f} % of a case's "
-            f"run time; fixed cost of a batch (plan, table, plot): {s['fixed_s']:.2f} s"]
+    return batch_lines(s, rows[0]["cases"])
+
+
+def batch_lines(s, cases):
+    """The batch part's lines: no speed-up figure when the rounds spread too much, no
+    dispatch overhead when the one measured is below zero (the cases' own times vary more
+    than the machinery costs)."""
+    from . import batch_cost
+    speedup = (f"too noisy ({over(s['spread'], batch_cost.NOISY)} between rounds), no figure" if s["noisy"]
+               else f"{s['speedup']:.2f}×")
+    overhead = (f"{1e3 * s['overhead_s']:.0f} ms = {100 * s['share']:.1f} % of a case's run time"
+                if s["overhead_s"] > 0 and not s["noisy"] else
+                "below the noise of the cases' own run times, no figure" if not s["noisy"] else
+                "too noisy, no figure")
+    return [f"speed-up 1 → 2 workers: {speedup} ({cases} cases of {s['case_s']:.2f} s each on one worker)",
+            f"dispatch overhead per case: {overhead}; fixed cost of a batch (plan, table, plot): {s['fixed_s']:.2f} s"]
 
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,

@@ -377,12 +377,13 @@ def drag_run(speed, dt, algorithm="gauss-seidel", mass=MASS, c=1.0e4, current=0.
 
 
 # -- everything, for `hydrofmu bench` -------------------------------------------------
-def run(folder):
-    """Write added_mass_map.csv and added_mass_map.png into ``folder``; returns their paths."""
+def run(folder, n_steps=400):
+    """Write added_mass_map.csv and added_mass_map.png into ``folder`` (``n_steps`` per
+    simulated point); returns their paths."""
     from pathlib import Path
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    result = added_mass_map()
+    result = added_mass_map(n_steps=n_steps)
     rows = ["ratio,step,rho_explicit,growth_explicit,rho_export,growth_export"]
     for i, r in enumerate(result["ratios"]):
         for j, h in enumerate(result["steps"]):
