@@ -89,3 +89,15 @@ def test_a_typo_in_a_case_file_is_flagged():
     doc["transeint"] = 10.0
     errors = list(jsonschema.Draft7Validator(shipped("cases.schema.json")).iter_errors(doc))
     assert any("transeint" in e.message for e in errors)
+
+
+def test_the_validator_takes_its_keys_from_keys_py():
+    """One definition: every key set the scene and case readers check against comes from
+    keys.py (a literal set there would let the schema drift), every effect type has its keys."""
+    import re
+    from hydrofmu import keys, scene
+    for module in ("scene.py", "batch.py"):
+        text = (ROOT / "fmu_src" / "hydrofmu" / module).read_text(encoding="utf-8")
+        literal = re.findall(r"known_keys\([^)]*[{\[]", text)
+        assert not literal, f"{module}: key sets belong in keys.py: {literal}"
+    assert set(scene.EFFECT_TYPES) == set(keys.EFFECTS), "an effect type without its keys in keys.py"
