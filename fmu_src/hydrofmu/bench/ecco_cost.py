@@ -40,15 +40,18 @@ def motion_error(result, ref_time, ref, bodies):
     return float(nrms(got[:, moving], ref[:, moving]).max())
 
 
-def cases(folder, stop, fine):
+def cases(folder, stop, fine, scenes=None):
     """(label, built folder, bodies, reference) per case; ``reference(result)`` gives the
-    reference's (time, motion)."""
+    reference's (time, motion).  ``scenes``: the file names (stems) of models/ to take
+    (default: all)."""
     folder = Path(folder)
     fleet = Fleet(2)
     built = build_scene(load_scene(fleet.scene(folder / "two_body", run=f'preset = "adaptive"\nstop = {stop}')),
                         folder / "two_body" / "fmus", **QUIET)
     yield "two_body", built, fleet.names, lambda r: (r.time, fleet.monolithic(r.time))
     for path in sorted(Path("models").glob("*.toml")):
+        if scenes is not None and path.stem not in scenes:
+            continue
         scene = load_scene(path, {"run.algorithm": "ecco", "run.stop": stop})
         built = build_scene(scene, folder / "scenes", **QUIET)
         ref = master.run(built, algorithm="gauss-seidel", step=fine, progress=False)
@@ -56,13 +59,13 @@ def cases(folder, stop, fine):
         yield scene.name, built, bodies, lambda r, ref=ref, bodies=bodies: (ref.time, motion(ref, bodies))
 
 
-def measure(folder, stop=60.0, steps=(0.1, 0.05, 0.02), tolerances=(10.0, 1.0, 0.1), fine=0.005):
+def measure(folder, stop=60.0, steps=(0.1, 0.05, 0.02), tolerances=(10.0, 1.0, 0.1), fine=0.005, scenes=None):
     """Rows {case, algorithm, engine, knob, error, steps, min_step, max_step, wall_s,
     residual_J, residual_rel, net_J} and {case: the ECCO Result at the middle tolerance}.
     ``tolerances``: ECCO's abs_tolerance [J] (the knob that moves its steps on our scenes;
     rel_tolerance from 1e-4 to 1e-2 changed no run's step count by more than 0.5 %)."""
     rows, traces = [], {}
-    for label, built, bodies, reference in cases(folder, stop, fine):
+    for label, built, bodies, reference in cases(folder, stop, fine, scenes):
         runs = [(alg, f"step {h:g} s", {"algorithm": alg.split()[0], "step": h})
                 for alg in ("jacobi", "gauss-seidel", "jacobi (libcosim)") for h in steps]
         runs += [("ecco", f"abs_tolerance {tol:g} J", {"algorithm": "ecco", "ecco": {"abs_tolerance": tol}})
