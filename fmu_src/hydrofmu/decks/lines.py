@@ -189,12 +189,6 @@ def _osa(a, b):
 END_KEY = Keyword(END)
 
 
-def is_keyword(line, keyword):
-    """True if ``line`` is the keyword line ``keyword`` (a spelling or a Keyword)."""
-    key = keyword if isinstance(keyword, Keyword) else Keyword(keyword)
-    return key.matches(line.words)
-
-
 class Grammar:
     """The keywords a reader knows: ``groups`` (top-level data groups), ``inner`` (sub-groups,
     legal only inside their group), ``once`` (groups a file may hold once) and ``stems``
@@ -223,11 +217,9 @@ class Grammar:
         for key in self.groups + self.inner:
             why = key.resembles(words)
             if why:
+                hint = "" if self.exact else "; write it as the manual prints it (capitals required)"
                 raise line.error(field_ or ("data group" if not self.exact else key.spelling),
-                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is "
-                                               f"not it ({why}); write it as the manual prints it (capitals required)"
-                                 if not self.exact else
-                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is not it ({why})")
+                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is not it ({why}){hint}")
         for stem in self.stems:
             n = len(stem.words)
             if len(words) >= n and all(stem._word(k, w) == "match" for k, w in enumerate(words[:n])):
@@ -310,8 +302,9 @@ def after_group(cur, starts_group, owner, expected="a new data group"):
     line there (a count exceeded, a row too many) is an error, never skipped."""
     nxt = cur.peek()
     if nxt is not None and not is_end(nxt) and not starts_group(nxt):
-        raise nxt.error("data group identifier", f"unexpected line {nxt.text!r} after {owner}: the layout has no further "
-                                      f"line here (a count exceeded or a row too many?); expected {expected}")
+        raise nxt.error("data group identifier", f"unexpected line {nxt.text!r} after {owner}: the layout has no "
+                                                 f"further line here (a count exceeded or a row too many?); "
+                                                 f"expected {expected}")
 
 
 def interrupted(unknown, owner, rest):
