@@ -29,7 +29,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..admissible import finite_problem
+from ..admissible import finite_problem, odd_direction
 from ..errors import InputError, InputWarning
 from ..textfile import read_text
 
@@ -420,7 +420,7 @@ def check_profile(rows, where, reading=None):
         k, name, message = problem
         raise at(k, name).error(where[k][1][name], message)
     for k, row in enumerate(rows):
-        if reading is not None and not 0.0 <= row[2] <= 360.0:
-            reading.warn(at(k, "direction"), where[k][1]["direction"],
-                         f"direction {row[2]:g}° is outside 0…360° (read as {row[2] % 360.0:g}°): a typing slip?")
+        odd = odd_direction(row[2])
+        if reading is not None and odd:
+            reading.warn(at(k, "direction"), where[k][1]["direction"], odd)
     return rows
