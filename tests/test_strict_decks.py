@@ -4,6 +4,7 @@ keyword rule is the manuals' (capitals required, lower-case letters optional); w
 read and skipped is printed and kept in the manifest; suspicious but legal data warns.
 The mutation suite over every valid test deck is tests/test_deck_mutations.py."""
 import json
+import re
 import warnings
 
 import numpy as np
@@ -176,3 +177,16 @@ def test_legal_variants_still_read_the_same(tmp_path):
         got = read_couplings(write(tmp_path, SIMO_BARE.replace("HYDR COUP DATA", form), "b.sys"), bodies=["A"])
         np.testing.assert_array_equal(got["C1"].added_mass, base.added_mass)
         assert all(np.array_equal(got["C1"].kernels[k], base.kernels[k]) for k in base.kernels)
+
+
+def test_direction_of_370_degrees_in_the_scene_warns(tmp_path):
+    """The same in a scene: the uniform current and an inline profile's levels."""
+    from hydrofmu.scene import load_scene
+    base = SCENE.replace('current_deck = "c.txt"\ncurrent_format = "sima"', "{current}")
+    write(tmp_path, AQWA_WHOLE, "a.dat")
+    for current, key in (("current_speed = 1.0\ncurrent_direction = 370.0", "environment.current_direction"),
+                         ("current_profile = [[0.0, 1.0, 10.0], [-20.0, 0.5, -30.0]]", "environment.current_profile[1]")):
+        with pytest.warns(InputWarning, match=rf"{re.escape(key)}: direction .* is outside 0…360°") as said:
+            scene = load_scene(write_scene(tmp_path, base.format(current=current)))
+        assert len([w for w in said if "outside 0…360" in str(w.message)]) == 1
+        assert any("outside 0…360" in w for w in scene.warnings)

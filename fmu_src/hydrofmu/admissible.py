@@ -69,6 +69,14 @@ def negative_diagonal(matrix):
                 "(a drag diagonal is normally ≥ 0)") for k in np.flatnonzero(d < 0.0)]
 
 
+def odd_direction(degrees):
+    """Suspicious, not wrong: a direction outside 0…360° (370° is 10°: a typing slip?).
+    Returns the message, or None."""
+    if 0.0 <= degrees <= 360.0:
+        return None
+    return f"direction {degrees:g}° is outside 0…360° (read as {degrees % 360.0:g}°): a typing slip?"
+
+
 def _list(values):
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
 

@@ -782,8 +782,11 @@ def _current(problems, env):
                                                             "(uniform), current_profile or current_deck")
         return None, None, None
     if not given:
-        return (problems.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True),
-                problems.number(env, "current_direction", "environment.current_direction", 0.0), None)
+        speed = problems.number(env, "current_speed", "environment.current_speed", 0.0, nonneg=True)
+        direction = problems.number(env, "current_direction", "environment.current_direction", 0.0)
+        if direction is not None and admissible.odd_direction(direction):
+            problems.warn("environment.current_direction", admissible.odd_direction(direction))
+        return speed, direction, None
     if "current_deck" in env:
         rows = _current_deck(problems, env)
     else:
@@ -796,6 +799,9 @@ def _current(problems, env):
                 rows = None
     if rows is None:
         return None, None, None
+    for k, row in enumerate(rows if "current_profile" in env else ()):
+        if admissible.odd_direction(row[2]):
+            problems.warn(f"environment.current_profile[{k}]", admissible.odd_direction(row[2]))
     profile = CurrentProfile.from_rows(rows)
     return profile.surface_speed, profile.surface_direction, [list(r) for r in rows]
 

@@ -29,7 +29,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..admissible import finite_problem
+from ..admissible import finite_problem, odd_direction
 from ..errors import InputError, InputWarning
 from ..textfile import read_text
 
@@ -189,12 +189,6 @@ def _osa(a, b):
 END_KEY = Keyword(END)
 
 
-def is_keyword(line, keyword):
-    """True if ``line`` is the keyword line ``keyword`` (a spelling or a Keyword)."""
-    key = keyword if isinstance(keyword, Keyword) else Keyword(keyword)
-    return key.matches(line.words)
-
-
 class Grammar:
     """The keywords a reader knows: ``groups`` (top-level data groups), ``inner`` (sub-groups,
     legal only inside their group), ``once`` (groups a file may hold once) and ``stems``
@@ -223,11 +217,9 @@ class Grammar:
         for key in self.groups + self.inner:
             why = key.resembles(words)
             if why:
+                hint = "" if self.exact else "; write it as the manual prints it (capitals required)"
                 raise line.error(field_ or ("data group" if not self.exact else key.spelling),
-                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is "
-                                               f"not it ({why}); write it as the manual prints it (capitals required)"
-                                 if not self.exact else
-                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is not it ({why})")
+                                 f"{line.text!r} looks like the keyword {key.spelling!r} but is not it ({why}){hint}")
         for stem in self.stems:
             n = len(stem.words)
             if len(words) >= n and all(stem._word(k, w) == "match" for k, w in enumerate(words[:n])):
@@ -310,8 +302,9 @@ def after_group(cur, starts_group, owner, expected="a new data group"):
     line there (a count exceeded, a row too many) is an error, never skipped."""
     nxt = cur.peek()
     if nxt is not None and not is_end(nxt) and not starts_group(nxt):
-        raise nxt.error("data group identifier", f"unexpected line {nxt.text!r} after {owner}: the layout has no further "
-                                      f"line here (a count exceeded or a row too many?); expected {expected}")
+        raise nxt.error("data group identifier", f"unexpected line {nxt.text!r} after {owner}: the layout has no "
+                                                 f"further line here (a count exceeded or a row too many?); "
+                                                 f"expected {expected}")
 
 
 def interrupted(unknown, owner, rest):
@@ -427,7 +420,7 @@ def check_profile(rows, where, reading=None):
         k, name, message = problem
         raise at(k, name).error(where[k][1][name], message)
     for k, row in enumerate(rows):
-        if reading is not None and not 0.0 <= row[2] <= 360.0:
-            reading.warn(at(k, "direction"), where[k][1]["direction"],
-                         f"direction {row[2]:g}° is outside 0…360° (read as {row[2] % 360.0:g}°): a typing slip?")
+        odd = odd_direction(row[2])
+        if reading is not None and odd:
+            reading.warn(at(k, "direction"), where[k][1]["direction"], odd)
     return rows
