@@ -402,3 +402,22 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
     code, line, _ = cli("demo", "-o", tmp_path / "d", "--scene", "moored_barg")
     assert code == 2 and "--scene: no scene 'moored_barg' in models/ (did you mean 'moored_barge'" in line
     assert not (tmp_path / "d").exists()
+
+
+def test_batch_results_kept_when_its_folder_refuses_them(tmp_path, demo_build, monkeypatch):
+    """cases/ stops taking files mid-batch: the rows are kept for the table, one warning says so."""
+    distributed = pytest.importorskip("distributed")
+    from hydrofmu import batch as batch_module
+
+    def full(path, obj):
+        raise OSError(28, "No space left on device", str(path))
+    monkeypatch.setattr(batch_module, "_write_json", full)
+    path = tmp_path / "cases.toml"
+    path.write_text(f'scene = "{demo_build}"\nstop = 0.2\noutputs = ["barge.force[1]"]\n'
+                    '[matrix]\n"environment.current_speed" = [0.5, 1.0]\n')
+    said = []
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=":0") as client:
+        table = run_batch(path, tmp_path / "out", client=client, progress=False, log=said.append)
+    assert list(table["status"]) == ["ok", "ok"] and table["barge.force[1].max"].notna().all()
+    assert len(said) == 1 and said[0].startswith(f"warning: cannot write in {tmp_path / 'out'} (No space left")
+    assert table.attrs["written"][tmp_path / "out" / "cases.csv"] == tmp_path / "out" / "cases.csv"

@@ -184,12 +184,14 @@ def batch(args):
     table = run_batch(args.cases, out, workers=args.workers, scheduler=args.scheduler,
                       series=True if args.series else None, retry_failed=args.retry_failed)
     counts = table["status"].value_counts().to_dict()
-    wrote = ", ".join(str(out / f) for f in ("cases.csv", "cases.parquet", "cases.png") if (out / f).exists())
+    written = table.attrs.get("written", {})
+    wrote = ", ".join(str(p) for p in written.values())
     print(f"batch: {len(table)} cases, " + ", ".join(f"{n} {s}" for s, n in sorted(counts.items()))
           + f"; wrote {wrote}")
     for _, row in table[table["status"] != "ok"].head(10).iterrows():
         print(f"  case {row['case']}: {row['status']}: {row['error']}")
-    return 0 if counts.get("ok", 0) == len(table) else 1
+    moved = any(asked != got for asked, got in written.items())
+    return 0 if counts.get("ok", 0) == len(table) and not moved else 1
 
 
 HELP = """\
