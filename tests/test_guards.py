@@ -421,3 +421,33 @@ def test_batch_results_kept_when_its_folder_refuses_them(tmp_path, demo_build, m
     assert list(table["status"]) == ["ok", "ok"] and table["barge.force[1].max"].notna().all()
     assert len(said) == 1 and said[0].startswith(f"warning: cannot write in {tmp_path / 'out'} (No space left")
     assert table.attrs["written"][tmp_path / "out" / "cases.csv"] == tmp_path / "out" / "cases.csv"
+
+
+def test_two_deck_bodies_mapped_to_one_scene_body(tmp_path):
+    deck = ROOT / "tests" / "data" / "simo" / "two_barges.sys"
+    path = write_scene(tmp_path, f"""
+        [bodies.a]
+        mass = 1.0e6
+        inertia = [1.0e8, 1.0e8, 1.0e8]
+        [[couplings]]
+        deck = "{deck}"
+        coupling = "cpl12"
+        bodies = {{ barge1 = "a", barge2 = "a" }}
+        """)
+    assert "couplings[0].bodies: SIMO bodies barge1, barge2 are all mapped to scene body 'a'" in scene_error(path)
+
+
+def test_a_broken_build_folder_is_named_not_an_internal_error(tmp_path, demo_build):
+    import shutil
+    folder = tmp_path / "copy"
+    shutil.copytree(demo_build, folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    for text, words in [("{", "manifest.json:1: json: not a manifest"),
+                        (json.dumps({**manifest, "run": {"step": 0.1}}), "manifest.json: run.stop: missing"),
+                        (json.dumps({**manifest, "order": manifest["order"] + ["ghost"]}),
+                         "manifest.json: instances.ghost.fmu: None is not in the folder")]:
+        (folder / "manifest.json").write_text(text)
+        code, line, _ = cli("run", folder, "--csv", tmp_path / "r.csv")
+        assert code == 2 and words in line and not (tmp_path / "r.csv").exists()
+        with pytest.raises(InputError, match=words.split(": ", 1)[1]):
+            hydrofmu.run(folder)

@@ -42,6 +42,7 @@ import numpy as np
 
 from .errors import InputError, InputWarning
 from .names import did_you_mean, unknown
+from .cosim.manifest import read_manifest
 from .textfile import read_toml
 from .writable import check_folder
 
@@ -224,7 +225,7 @@ def check_knobs(batch):
     import copy
     from .scene import load_scene, override
     if batch.scene.is_dir():
-        run = json.loads((batch.scene / "manifest.json").read_text())["run"]
+        run = read_manifest(batch.scene)["run"]
     else:
         doc = read_toml(batch.scene, "scene")
         first = {k: v for k, v in _first_values(batch).items()
@@ -344,7 +345,7 @@ class Variants:
     def _make(self, overrides):
         if self.batch.scene.is_dir():
             folder = self.batch.scene
-            manifest = json.loads((folder / "manifest.json").read_text())
+            manifest = read_manifest(folder)
             files = sorted(str(f.relative_to(folder)) for f in folder.iterdir() if f.is_file())
             vid = _digest([self.runtime, str(folder), files, [(folder / f).stat().st_mtime for f in files]])
             run = {k: manifest["run"][k] for k in ("step", "stop", "algorithm")}
@@ -394,7 +395,7 @@ class Variants:
 def _variables(folder):
     """{'instance.variable': causality} of a built scene's FMUs."""
     from fmpy import read_model_description
-    manifest = json.loads((Path(folder) / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     out = {}
     for name, inst in manifest["instances"].items():
         for v in read_model_description(str(Path(folder) / inst["fmu"])).modelVariables:

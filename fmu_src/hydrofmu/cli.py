@@ -1,7 +1,6 @@
 """Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
-import json
 import math
 import os
 import sys
@@ -11,6 +10,7 @@ from pathlib import Path
 
 from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
 from .cosim.master import describe
+from .cosim.manifest import read_manifest
 from .cosim.master import check_steps
 from .errors import InputError, InputWarning
 from .names import did_you_mean
@@ -68,10 +68,8 @@ def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, a
     for key, value in (("step", step), ("stop", stop)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, f"--{key}", f"must be a positive finite number, found {value:g}")
-    if folder is not None and not (Path(folder) / "manifest.json").is_file():
-        raise InputError(folder, None, "scene", "not a scene .toml nor a built scene folder (no manifest.json)")
     if run is None and folder is not None:
-        run = json.loads((Path(folder) / "manifest.json").read_text())["run"]
+        run = read_manifest(folder)["run"]
     if run is not None:
         given = [f"--{k}" for k, v in (("stop", stop), ("step", step)) if v is not None]
         check_steps(stop or run["stop"], step or run["step"], algorithm or run["algorithm"],

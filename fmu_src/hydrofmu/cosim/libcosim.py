@@ -13,13 +13,13 @@ Two of libcosim's algorithms:
 
 libcosim counts time in integer nanoseconds.
 """
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
 from .bonds import columns, power_bonds
+from .manifest import read_manifest
 from .master import check_names, check_steps, run_settings
 from .result import Result, column_units
 
@@ -42,7 +42,7 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
 
     log_output_level(CosimLogLevel.WARNING)
     folder = Path(folder)
-    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     wanted = algorithm or manifest["run"]["algorithm"]
     if wanted not in ("jacobi", "ecco"):
         where = "--algorithm" if algorithm else folder / "manifest.json"
@@ -139,7 +139,7 @@ def engine_for(folder, algorithm=None, engine=None):
     if engine is not None:
         return engine
     if algorithm is None:
-        algorithm = json.loads((Path(folder) / "manifest.json").read_text())["run"]["algorithm"]
+        algorithm = read_manifest(folder)["run"]["algorithm"]
     return "libcosim" if algorithm == "ecco" else "fmpy"
 
 
