@@ -111,6 +111,9 @@ def test_run_stop_rule_in_the_scene_the_api_and_the_masters(tmp_path, demo_build
     assert not (tmp_path / "r.csv").exists()
     # 0.3 / 0.1 is 2.9999999999999996 in floating point: a whole number of steps
     assert master.check_steps(0.3, 0.1, "jacobi", "run") == 3
+    # more steps than memory holds: refused, not a MemoryError after the build
+    code, line, _ = cli("run", BARGE, "-o", tmp_path / "o", "--step", "1e-300")
+    assert code == 2 and "--step: 6e+302 steps of 1e-300 s to 600 s: more than 1e+08" in line
 
 
 def test_run_record_and_parameters_names_suggest_the_closest(demo_build):
