@@ -341,6 +341,7 @@ def test_bem2simo_options_and_outputs(tmp_path):
         (["--symmetry-tolerance", "nan"], "command line: --symmetry-tolerance: must be a positive finite number, found nan"),
         (["--kernel-length", "0"], "command line: --kernel-length: must be a positive finite number, found 0"),
         (["--timdel", "-0.1"], "command line: --timdel: must be a positive finite number, found -0.1"),
+        (["--kernel-length", "1e9"], "cylinders.nc: kernel_length: 1.91e+10 kernel samples"),   # not a MemoryError
     ]:
         code, line, _ = cli("bem2simo", CYL, "-o", out, *args)
         assert code == 2 and words in line and not out.exists()
