@@ -117,6 +117,8 @@ def test_run_stop_rule_in_the_scene_the_api_and_the_masters(tmp_path, demo_build
 
 
 def test_run_record_and_parameters_names_suggest_the_closest(demo_build):
+    with pytest.raises(InputError, match=r"algorithm: unknown algorithm 'jacoby' \(did you mean 'jacobi'"):
+        hydrofmu.run(demo_build, stop=0.2, algorithm="jacoby")
     with pytest.raises(InputError, match=r"record: unknown 'instance.variable' 'barge.forse\[1\]' "
                                          r"\(did you mean 'barge.force\[1\]'"):
         hydrofmu.run(demo_build, stop=0.2, record=["barge.forse[1]"])

@@ -335,7 +335,7 @@ def _check_algorithm(algorithm, where):
         raise InputError(where, None, "algorithm", "ECCO (adaptive step) runs in libcosim only: use --engine "
                          "libcosim (engine='libcosim'), or --algorithm jacobi / gauss-seidel here")
     if algorithm not in ("jacobi", "gauss-seidel"):
-        raise ValueError(f"unknown algorithm {algorithm!r}")
+        raise InputError(where, None, "algorithm", unknown("algorithm", algorithm, ("jacobi", "gauss-seidel", "ecco")))
 
 
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
