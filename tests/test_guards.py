@@ -353,6 +353,13 @@ def test_bem2simo_options_and_outputs(tmp_path):
         assert code == 2 and words in line
     code, line, _ = cli("bem2simo", CYL, "-o", out, "--png", afile / "q.png")
     assert code == 2 and "q.png: output file:" in line and not out.exists()
+    # what the transform's report says out loud, in bem2simo's report too
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert cli_module.main(["bem2simo", str(CYL), "-o", str(out), "--kernel-length", "30"]) == 0
+    assert out.is_file() and "  WARNING: " in printed.getvalue()
+    assert "radiation_damping[cyl1__Heave, cyl1__Heave] is negative" in printed.getvalue()
+    out.unlink()
     # the API guards the same options
     from hydrofmu.bem import couplings
     from hydrofmu.decks.bem import read_bem
