@@ -176,6 +176,13 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     Result
         Time, recorded columns with their units, the run's settings and the manifest
         (``Result.to_csv``, ``Result.plot``).
+
+    Raises
+    ------
+    hydrofmu.InputError
+        Before anything is built or run: an invalid scene, a broken built folder, a
+        fixed-step ``stop`` that is not a whole number n ≥ 1 of ``step``, an unknown
+        engine, algorithm, ``record`` or ``parameters`` name (with the closest valid ones).
     """
     from .cosim.manifest import read_manifest
     from .cosim.master import check_steps
