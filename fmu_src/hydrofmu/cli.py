@@ -9,9 +9,8 @@ import zipfile
 from pathlib import Path
 
 from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
-from .cosim.master import describe
 from .cosim.manifest import read_manifest
-from .cosim.master import check_steps
+from .cosim.master import check_steps, describe
 from .errors import InputError, InputWarning
 from .names import did_you_mean
 from .writable import check_folder, check_outputs, keep
@@ -94,7 +93,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"), summary=summary)
     if not (math.isfinite(transient) and transient >= 0):
         raise InputError("command line", None, "--transient", f"must be a finite time ≥ 0 [s], found {transient:g}")
-    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
