@@ -111,9 +111,14 @@ def test_run_stop_rule_in_the_scene_the_api_and_the_masters(tmp_path, demo_build
     assert not (tmp_path / "r.csv").exists()
     # 0.3 / 0.1 is 2.9999999999999996 in floating point: a whole number of steps
     assert master.check_steps(0.3, 0.1, "jacobi", "run") == 3
+    # more steps than memory holds: refused, not a MemoryError after the build
+    code, line, _ = cli("run", BARGE, "-o", tmp_path / "o", "--step", "1e-300")
+    assert code == 2 and "--step: 6e+302 steps of 1e-300 s to 600 s: more than 1e+08" in line
 
 
 def test_run_record_and_parameters_names_suggest_the_closest(demo_build):
+    with pytest.raises(InputError, match=r"algorithm: unknown algorithm 'jacoby' \(did you mean 'jacobi'"):
+        hydrofmu.run(demo_build, stop=0.2, algorithm="jacoby")
     with pytest.raises(InputError, match=r"record: unknown 'instance.variable' 'barge.forse\[1\]' "
                                          r"\(did you mean 'barge.force\[1\]'"):
         hydrofmu.run(demo_build, stop=0.2, record=["barge.forse[1]"])
@@ -338,6 +343,7 @@ def test_bem2simo_options_and_outputs(tmp_path):
         (["--symmetry-tolerance", "nan"], "command line: --symmetry-tolerance: must be a positive finite number, found nan"),
         (["--kernel-length", "0"], "command line: --kernel-length: must be a positive finite number, found 0"),
         (["--timdel", "-0.1"], "command line: --timdel: must be a positive finite number, found -0.1"),
+        (["--kernel-length", "1e9"], "cylinders.nc: kernel_length: 1.91e+10 kernel samples"),   # not a MemoryError
     ]:
         code, line, _ = cli("bem2simo", CYL, "-o", out, *args)
         assert code == 2 and words in line and not out.exists()
@@ -347,6 +353,13 @@ def test_bem2simo_options_and_outputs(tmp_path):
         assert code == 2 and words in line
     code, line, _ = cli("bem2simo", CYL, "-o", out, "--png", afile / "q.png")
     assert code == 2 and "q.png: output file:" in line and not out.exists()
+    # what the transform's report says out loud, in bem2simo's report too
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert cli_module.main(["bem2simo", str(CYL), "-o", str(out), "--kernel-length", "30"]) == 0
+    assert out.is_file() and "  WARNING: " in printed.getvalue()
+    assert "radiation_damping[cyl1__Heave, cyl1__Heave] is negative" in printed.getvalue()
+    out.unlink()
     # the API guards the same options
     from hydrofmu.bem import couplings
     from hydrofmu.decks.bem import read_bem
@@ -402,3 +415,52 @@ def test_every_command_refuses_plain_bad_input(tmp_path, monkeypatch):
     code, line, _ = cli("demo", "-o", tmp_path / "d", "--scene", "moored_barg")
     assert code == 2 and "--scene: no scene 'moored_barg' in models/ (did you mean 'moored_barge'" in line
     assert not (tmp_path / "d").exists()
+
+
+def test_batch_results_kept_when_its_folder_refuses_them(tmp_path, demo_build, monkeypatch):
+    """cases/ stops taking files mid-batch: the rows are kept for the table, one warning says so."""
+    distributed = pytest.importorskip("distributed")
+    from hydrofmu import batch as batch_module
+
+    def full(path, obj):
+        raise OSError(28, "No space left on device", str(path))
+    monkeypatch.setattr(batch_module, "_write_json", full)
+    path = tmp_path / "cases.toml"
+    path.write_text(f'scene = "{demo_build}"\nstop = 0.2\noutputs = ["barge.force[1]"]\n'
+                    '[matrix]\n"environment.current_speed" = [0.5, 1.0]\n')
+    said = []
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=":0") as client:
+        table = run_batch(path, tmp_path / "out", client=client, progress=False, log=said.append)
+    assert list(table["status"]) == ["ok", "ok"] and table["barge.force[1].max"].notna().all()
+    assert len(said) == 1 and said[0].startswith(f"warning: cannot write in {tmp_path / 'out'} (No space left")
+    assert table.attrs["written"][tmp_path / "out" / "cases.csv"] == tmp_path / "out" / "cases.csv"
+
+
+def test_two_deck_bodies_mapped_to_one_scene_body(tmp_path):
+    deck = ROOT / "tests" / "data" / "simo" / "two_barges.sys"
+    path = write_scene(tmp_path, f"""
+        [bodies.a]
+        mass = 1.0e6
+        inertia = [1.0e8, 1.0e8, 1.0e8]
+        [[couplings]]
+        deck = "{deck}"
+        coupling = "cpl12"
+        bodies = {{ barge1 = "a", barge2 = "a" }}
+        """)
+    assert "couplings[0].bodies: SIMO bodies barge1, barge2 are all mapped to scene body 'a'" in scene_error(path)
+
+
+def test_a_broken_build_folder_is_named_not_an_internal_error(tmp_path, demo_build):
+    import shutil
+    folder = tmp_path / "copy"
+    shutil.copytree(demo_build, folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    for text, words in [("{", "manifest.json:1: json: not a manifest"),
+                        (json.dumps({**manifest, "run": {"step": 0.1}}), "manifest.json: run.stop: missing"),
+                        (json.dumps({**manifest, "order": manifest["order"] + ["ghost"]}),
+                         "manifest.json: instances.ghost.fmu: None is not in the folder")]:
+        (folder / "manifest.json").write_text(text)
+        code, line, _ = cli("run", folder, "--csv", tmp_path / "r.csv")
+        assert code == 2 and words in line and not (tmp_path / "r.csv").exists()
+        with pytest.raises(InputError, match=words.split(": ", 1)[1]):
+            hydrofmu.run(folder)

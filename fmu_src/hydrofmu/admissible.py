@@ -81,6 +81,7 @@ def _list(values):
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
 
 
+MAX_STEPS = 10 ** 8   # a run's results are kept in memory: 1e8 rows of a few dozen columns is tens of GB
 STEPS_TOL = 1e-9   # relative: stop/step within this of a whole number counts as whole (0.3/0.1 = 2.9999999999999996)
 
 
@@ -96,6 +97,9 @@ def whole_steps(stop, step):
     if ratio < 1 - STEPS_TOL:
         return 0, [("stop", f"stop {stop:g} s is shorter than one step ({step:g} s): nothing would run; "
                             f"use stop ≥ {step:g} s or a smaller step")]
+    if n > MAX_STEPS:
+        return 0, [("step", f"{n:.3g} steps of {step:g} s to {stop:g} s: more than {MAX_STEPS:.0e} "
+                            "(the recorded results alone would not fit in memory); use a larger step")]
     if abs(ratio - n) > STEPS_TOL * max(1.0, ratio):
         lo, hi = math.floor(ratio), math.ceil(ratio)
         return 0, [("stop", f"stop {stop:g} s is not a whole number of steps of {step:g} s ({ratio:.6g} steps): "

@@ -176,7 +176,15 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     Result
         Time, recorded columns with their units, the run's settings and the manifest
         (``Result.to_csv``, ``Result.plot``).
+
+    Raises
+    ------
+    hydrofmu.InputError
+        Before anything is built or run: an invalid scene, a broken built folder, a
+        fixed-step ``stop`` that is not a whole number n ≥ 1 of ``step``, an unknown
+        engine, algorithm, ``record`` or ``parameters`` name (with the closest valid ones).
     """
+    from .cosim.manifest import read_manifest
     from .cosim.master import check_steps
     if engine not in (None, "fmpy", "libcosim"):
         raise InputError("run", None, "engine", f"must be 'fmpy' or 'libcosim', found {engine!r}")
@@ -188,7 +196,7 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     if isinstance(source, Scene) or Path(source).suffix == ".toml":
         reuse = None if isinstance(source, Scene) else built_folder(source, out)
         if reuse is not None:
-            cfg = json.loads((reuse / "manifest.json").read_text())["run"]
+            cfg = read_manifest(reuse)["run"]
             check_steps(stop or cfg["stop"], step or cfg["step"], algorithm or cfg["algorithm"], "run")
             log(f"reusing {reuse}: the scene, its decks and hydrofmu are unchanged since it was built")
             folder = reuse
@@ -200,8 +208,8 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
             check_steps(stop or scene.run["stop"], step or scene.run["step"], algorithm or scene.run["algorithm"],
                         "run")
             folder = Path(build_scene(scene, Path(out), log=log, inputs=inputs))
-    elif not (Path(folder) / "manifest.json").is_file():
-        raise InputError(folder, None, "source", "not a scene (.toml) nor a built scene folder (no manifest.json)")
+    else:
+        read_manifest(folder)
     from .cosim.libcosim import engine_for
     engine = engine_for(folder, algorithm, engine)
     if engine == "libcosim":

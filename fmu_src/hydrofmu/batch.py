@@ -43,6 +43,7 @@ import numpy as np
 from .errors import InputError, InputWarning
 from . import keys as file_keys
 from .names import did_you_mean, unknown
+from .cosim.manifest import read_manifest
 from .textfile import read_toml
 from .writable import check_folder
 
@@ -225,7 +226,7 @@ def check_knobs(batch):
     import copy
     from .scene import load_scene, override
     if batch.scene.is_dir():
-        run = json.loads((batch.scene / "manifest.json").read_text())["run"]
+        run = read_manifest(batch.scene)["run"]
     else:
         doc = read_toml(batch.scene, "scene")
         first = {k: v for k, v in _first_values(batch).items()
@@ -345,7 +346,7 @@ class Variants:
     def _make(self, overrides):
         if self.batch.scene.is_dir():
             folder = self.batch.scene
-            manifest = json.loads((folder / "manifest.json").read_text())
+            manifest = read_manifest(folder)
             files = sorted(str(f.relative_to(folder)) for f in folder.iterdir() if f.is_file())
             vid = _digest([self.runtime, str(folder), files, [(folder / f).stat().st_mtime for f in files]])
             run = {k: manifest["run"][k] for k in ("step", "stop", "algorithm")}
@@ -395,7 +396,7 @@ class Variants:
 def _variables(folder):
     """{'instance.variable': causality} of a built scene's FMUs."""
     from fmpy import read_model_description
-    manifest = json.loads((Path(folder) / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     out = {}
     for name, inst in manifest["instances"].items():
         for v in read_model_description(str(Path(folder) / inst["fmu"])).modelVariables:
@@ -636,15 +637,23 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
     if scheduler and client is None:   # a wrong address is told before anything is built
         client_, closing = _open_client(None, scheduler, None)
 
+    kept = {}   # case rows that could not be written to cases/ (disk full, folder gone): the table has them
+
     def record(cid, knobs, variant, result):
-        (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
-        if result.get("series") is not None:
-            (out / "series").mkdir(exist_ok=True)
-            _write_series(out / "series" / f"{cid}.parquet", *result["series"], batch.outputs)
-        _write_json(out / "cases" / f"{cid}.json", {
-            "case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
-            "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
-            "worker": result.get("worker")})
+        row = {"case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
+               "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
+               "worker": result.get("worker")}
+        try:
+            (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
+            if result.get("series") is not None:
+                (out / "series").mkdir(exist_ok=True)
+                _write_series(out / "series" / f"{cid}.parquet", *result["series"], batch.outputs)
+            _write_json(out / "cases" / f"{cid}.json", row)
+        except OSError as exc:
+            if not kept:
+                log(f"warning: cannot write in {out} ({exc.strerror or exc}): the cases' results are kept for "
+                    "the table (written elsewhere if need be), time series are lost")
+            kept[cid] = row
         bar.update(ok=result["status"] == "ok")
 
     try:
@@ -685,7 +694,7 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
         for c in closing:
             c.close()
         bar.close()
-    return assemble_table(out, ids, batch, _output_units(variants, batch.outputs))
+    return assemble_table(out, ids, batch, _output_units(variants, batch.outputs), kept, log)
 
 
 def _output_units(variants, outputs):
@@ -725,21 +734,29 @@ def read_series(out, case):
     return pd.read_parquet(Path(out) / "series" / f"{case}.parquet")
 
 
-def assemble_table(out, ids, batch, units=None):
-    """The batch table from the per-case files: one row per case (knobs, status, wall time,
-    statistics, error, case id, build id); written as cases.csv, cases.parquet and the plot."""
+def assemble_table(out, ids, batch, units=None, kept=None, log=print):
+    """The batch table from the per-case files (or ``kept``: rows that could not be written):
+    one row per case (knobs, status, wall time, statistics, error, case id, build id); written
+    as cases.csv, cases.parquet and the plot, each to a fallback folder when ``out`` refuses
+    it (``table.attrs['written']``: asked path → path written)."""
     import pandas as pd
+    from .writable import keep
     rows = []
     for cid in ids:
-        r = json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
+        r = (kept or {}).get(cid) or json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
         rows.append({**{k: _cell(v) for k, v in r["knobs"].items()}, "status": r["status"], "wall_s": r["wall_s"],
                      **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
     stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
     columns = batch.keys + ["status", "wall_s"] + stats + ["error", "case", "build"]
     table = pd.DataFrame(rows, columns=columns)
-    table.to_csv(Path(out) / "cases.csv", index=False)
-    table.to_parquet(Path(out) / "cases.parquet", index=False)
-    plot(table, batch, Path(out) / "cases.png", units)
+    written = {}
+    for name, write in (("cases.csv", lambda p: table.to_csv(p, index=False)),
+                        ("cases.parquet", lambda p: table.to_parquet(p, index=False)),
+                        ("cases.png", lambda p: plot(table, batch, p, units))):
+        path, _ = keep(write, Path(out) / name, log)
+        if path.exists():   # no plot without a numeric knob
+            written[Path(out) / name] = path
+    table.attrs["written"] = written
     return table
 
 

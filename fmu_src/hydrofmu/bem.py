@@ -17,7 +17,7 @@ import numpy as np
 from .decks.bem import DOF_NAMES, BemData
 from .decks.simo import BODY, CouplingData, format_coupling, write_couplings
 from .errors import InputError
-from .physics.radiation import SYMMETRY_TOL, AsymmetryError, GridError, Radiation, transform
+from .physics.radiation import SYMMETRY_TOL, TIMDEL_FACTOR, AsymmetryError, GridError, Radiation, transform
 
 
 @dataclass
@@ -122,6 +122,14 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
     if a_inf_from == "file" and data.a_inf is None:
         raise InputError(path, None, "a_inf", "a_inf = \"file\" but the file has no infinite-frequency added mass "
                                               "(Capytaine: omega = inf; WAMIT: PER = 0)")
+    # the kernels are kept in memory: refuse a length/TIMDEL that could not be (defaults as the transform's)
+    w = data.omega
+    top = max(length or 0.0, 2 * np.pi / np.max(np.diff(np.concatenate([[0.0], w]))))   # the transform's time grid
+    dt = timdel if timdel is not None else np.pi / (TIMDEL_FACTOR * w[-1])
+    if top / dt > MAX_KERNEL_SAMPLES:
+        raise InputError(path, None, "kernel_length" if length is not None and length >= top else "timdel",
+                         f"{top / dt:.3g} kernel samples (length {top:g} s / TIMDEL {dt:g} s): more than "
+                         f"{MAX_KERNEL_SAMPLES:.0e}; shorten the kernel or coarsen TIMDEL")
     sel = np.ix_(range(data.omega.size), keep, keep)
     kept = [data.dofs[i] for i in keep]
     try:
@@ -162,6 +170,7 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
     return BemCouplings(data, out, rad, kept, dict(bodies), checks)
 
 
+MAX_KERNEL_SAMPLES = 10 ** 5   # per dof pair (the defaults give a few thousand): the transform holds them for every pair
 KERNEL_MIN_STEPS = 5      # a kernel of fewer TIMDEL than this is said out loud
 NEGATIVE_DAMPING = 1e-3   # B_ii(ω) below −this × max|B_ii| is said out loud (noise near zero is not)
 

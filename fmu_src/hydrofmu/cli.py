@@ -1,7 +1,6 @@
 """Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
-import json
 import math
 import os
 import sys
@@ -10,8 +9,8 @@ import zipfile
 from pathlib import Path
 
 from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
-from .cosim.master import describe
-from .cosim.master import check_steps
+from .cosim.manifest import read_manifest
+from .cosim.master import check_steps, describe
 from .errors import InputError, InputWarning
 from .names import did_you_mean
 from .writable import check_folder, check_outputs, keep
@@ -68,10 +67,8 @@ def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, a
     for key, value in (("step", step), ("stop", stop)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, f"--{key}", f"must be a positive finite number, found {value:g}")
-    if folder is not None and not (Path(folder) / "manifest.json").is_file():
-        raise InputError(folder, None, "scene", "not a scene .toml nor a built scene folder (no manifest.json)")
     if run is None and folder is not None:
-        run = json.loads((Path(folder) / "manifest.json").read_text())["run"]
+        run = read_manifest(folder)["run"]
     if run is not None:
         given = [f"--{k}" for k, v in (("stop", stop), ("step", step)) if v is not None]
         check_steps(stop or run["stop"], step or run["step"], algorithm or run["algorithm"],
@@ -96,7 +93,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"), summary=summary)
     if not (math.isfinite(transient) and transient >= 0):
         raise InputError("command line", None, "--transient", f"must be a finite time ≥ 0 [s], found {transient:g}")
-    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
@@ -184,12 +181,14 @@ def batch(args):
     table = run_batch(args.cases, out, workers=args.workers, scheduler=args.scheduler,
                       series=True if args.series else None, retry_failed=args.retry_failed)
     counts = table["status"].value_counts().to_dict()
-    wrote = ", ".join(str(out / f) for f in ("cases.csv", "cases.parquet", "cases.png") if (out / f).exists())
+    written = table.attrs.get("written", {})
+    wrote = ", ".join(str(p) for p in written.values())
     print(f"batch: {len(table)} cases, " + ", ".join(f"{n} {s}" for s, n in sorted(counts.items()))
           + f"; wrote {wrote}")
     for _, row in table[table["status"] != "ok"].head(10).iterrows():
         print(f"  case {row['case']}: {row['status']}: {row['error']}")
-    return 0 if counts.get("ok", 0) == len(table) else 1
+    moved = any(asked != got for asked, got in written.items())
+    return 0 if counts.get("ok", 0) == len(table) and not moved else 1
 
 
 HELP = """\

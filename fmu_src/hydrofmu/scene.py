@@ -16,7 +16,7 @@ from . import admissible, keys
 from .description import Effect, HydroCoupling, Kernel
 from .errors import InputError, InputWarning
 from .names import did_you_mean
-from .textfile import read_text, read_toml
+from .textfile import read_toml
 
 ACCEL_MODES = ("export", "explicit")
 
@@ -448,6 +448,11 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         if not isinstance(mapping, dict) or any(v not in bodies for v in mapping.values()):
             problems.add(f"{where}.bodies", "expected a table SIMO body name = scene body name, "
                                             f"scene bodies: {', '.join(bodies)}")
+            continue
+        twice = [v for v in set(mapping.values()) if list(mapping.values()).count(v) > 1]
+        if twice:
+            problems.add(f"{where}.bodies", f"SIMO bodies {', '.join(k for k, v in mapping.items() if v == twice[0])} "
+                                            f"are all mapped to scene body {twice[0]!r}: one deck body per scene body")
             continue
         known = set(mapping) | set(bodies)
         path = _deck_path(problems, table, where)

@@ -13,13 +13,14 @@ Two of libcosim's algorithms:
 
 libcosim counts time in integer nanoseconds.
 """
-import json
 from pathlib import Path
 
 import numpy as np
 
+from ..admissible import MAX_STEPS
 from ..errors import InputError
 from .bonds import columns, power_bonds
+from .manifest import read_manifest
 from .master import check_names, check_steps, run_settings
 from .result import Result, column_units
 
@@ -42,7 +43,7 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
 
     log_output_level(CosimLogLevel.WARNING)
     folder = Path(folder)
-    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     wanted = algorithm or manifest["run"]["algorithm"]
     if wanted not in ("jacobi", "ecco"):
         where = "--algorithm" if algorithm else folder / "manifest.json"
@@ -64,6 +65,9 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
         if not ecco["min_step"] <= step <= ecco["max_step"]:
             raise InputError("--step", None, "step", f"ECCO's first step must lie within [min_step, max_step] = "
                              f"[{ecco['min_step']:g}, {ecco['max_step']:g}] s, found {step:g}")
+        if stop > MAX_STEPS * ecco["min_step"]:   # ECCO may take stop/min_step steps, each kept in memory
+            raise InputError("run", None, "stop", f"stop {stop:g} s is more than {MAX_STEPS:.0e} of ECCO's min_step "
+                                                  f"({ecco['min_step']:g} s): raise min_step or shorten the run")
         algo = CosimAlgorithm.create_ecco_algorithm(ecco_params(EccoParams, ecco, step))
         execution = CosimExecution.from_algorithm(algo)
         capacity = int(np.ceil(stop / ecco["min_step"])) + 3   # most steps ECCO can take
@@ -139,7 +143,7 @@ def engine_for(folder, algorithm=None, engine=None):
     if engine is not None:
         return engine
     if algorithm is None:
-        algorithm = json.loads((Path(folder) / "manifest.json").read_text())["run"]["algorithm"]
+        algorithm = read_manifest(folder)["run"]["algorithm"]
     return "libcosim" if algorithm == "ecco" else "fmpy"
 
 

@@ -18,7 +18,6 @@ import shutil
 import sys
 import time as clock
 from pathlib import Path
-import json
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -29,6 +28,7 @@ from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2Ca
 from ..admissible import whole_steps
 from ..errors import InputError
 from ..names import unknown
+from .manifest import read_manifest
 from .result import Result
 
 
@@ -295,7 +295,7 @@ class System:
 def load(folder, parameters=None):
     """The System of a built scene's folder (its manifest.json and FMUs), loaded with fmpy."""
     folder = Path(folder)
-    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest = read_manifest(folder)
     instances = {}
     try:
         for name in manifest["order"]:
@@ -335,7 +335,7 @@ def _check_algorithm(algorithm, where):
         raise InputError(where, None, "algorithm", "ECCO (adaptive step) runs in libcosim only: use --engine "
                          "libcosim (engine='libcosim'), or --algorithm jacobi / gauss-seidel here")
     if algorithm not in ("jacobi", "gauss-seidel"):
-        raise ValueError(f"unknown algorithm {algorithm!r}")
+        raise InputError(where, None, "algorithm", unknown("algorithm", algorithm, ("jacobi", "gauss-seidel", "ecco")))
 
 
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
@@ -350,7 +350,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     """
     own = not isinstance(folder, System)
     if own:   # refuse ECCO before loading anything
-        _check_algorithm(algorithm or json.loads((Path(folder) / "manifest.json").read_text())["run"]["algorithm"],
+        _check_algorithm(algorithm or read_manifest(folder)["run"]["algorithm"],
                          folder)
     system = load(folder, parameters) if own else folder
     t = 0.0
