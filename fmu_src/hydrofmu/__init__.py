@@ -5,6 +5,7 @@ Public API (imported on first use, so ``import hydrofmu`` stays cheap):
 - ``load_scene(path) -> Scene``: read and validate a scene file;
 - ``build(scene, out) -> Path``: build its FMUs into ``out/<scene name>/``;
 - ``run(scene_or_folder, stop=..., step=...) -> Result``: build if needed and run;
+- ``tune(scene, tolerance) -> Tuning``: the cheapest run settings within a tolerance;
 - ``Result`` (``to_csv``, ``plot``, ``motion``, ``vector``) and ``read_csv``;
 - ``run_batch(cases, out) -> DataFrame``: a matrix of load cases on Dask, one row per
   case, and ``read_series(out, case)`` (the ``batch`` extra);
@@ -26,7 +27,7 @@ __version__ = "0.1.0"
 # public name -> module (relative to the package) that defines it
 _WHERE = {
     "load_scene": "api", "Scene": "scene", "InputError": "errors",
-    "build": "api", "run": "api", "run_batch": "batch", "read_series": "batch",
+    "build": "api", "run": "api", "tune": "tuning", "Tuning": "tuning", "run_batch": "batch", "read_series": "batch",
     "Result": "cosim.result", "read_csv": "cosim.result",
     "ViscousDrag": "physics.viscous_drag", "CurrentPolar": "physics.current_polar",
     "LumpedBody": "physics.lumped", "BallJoint": "physics.joint", "Coupling": "physics.coupling",

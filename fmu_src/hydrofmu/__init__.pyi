@@ -3,7 +3,7 @@ __version__: str
 __all__ = [
     'BallJoint', 'BodyLoads', 'Convolution', 'CoupledBodies', 'Coupling', 'CurrentPolar', 'Env',
     'InputError', 'LumpedBody', 'Motion', 'Result', 'RigidBody', 'Scene', 'StateSpace',
-    'ViscousDrag', '__version__', 'build', 'load_scene', 'read_csv', 'run',
+    'Tuning', 'ViscousDrag', '__version__', 'build', 'load_scene', 'read_csv', 'run', 'tune',
 ]
 
 from .api import build, load_scene, run
@@ -19,3 +19,4 @@ from .physics.rigid_body import CoupledBodies, RigidBody
 from .physics.state import Env, Motion
 from .physics.viscous_drag import ViscousDrag
 from .scene import Scene
+from .tuning import Tuning, tune

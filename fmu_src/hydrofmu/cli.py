@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | batch | validate | demo | bench | bem2simo`` (a thin layer
+"""Command line: ``hydrofmu build | run | tune | batch | validate | demo | bench | bem2simo`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
 import math
@@ -169,6 +169,44 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
     return made
 
 
+def tolerance(text):
+    """``'0.5%'`` -> 0.005, ``'0.005'`` -> 0.005; InputError naming --tolerance otherwise."""
+    value = str(text).strip()
+    try:
+        number = float(value[:-1]) / 100 if value.endswith("%") else float(value)
+    except ValueError:
+        raise InputError("command line", None, "--tolerance", f"expected a fraction or a percentage "
+                                                             f"(0.005 or 0.5%), found {text!r}") from None
+    return number
+
+
+def tune(args):
+    """``hydrofmu tune``: exit 0 with a choice, 1 when no setting met the tolerance."""
+    from .tuning import tune as run_tune, write_run_block
+    from .scene import load_scene
+    if args.repeats < 1:
+        raise InputError("command line", None, "--repeats", f"must be at least 1, found {args.repeats}")
+    name = load_scene(args.scene).name
+    png = args.png or Path("build") / "tune" / f"{name}.png"
+    if args.png is None:
+        check_folder(png.parent)
+        png.parent.mkdir(parents=True, exist_ok=True)
+    check_outputs(files=(png,) + ((args.scene,) if args.write else ()))
+    found = run_tune(args.scene, tolerance(args.tolerance), outputs=args.outputs, window=args.window,
+                     repeats=args.repeats, png=png, log=lambda s: None)
+    for line in found.report():
+        print(line)
+    print(f"wrote {png}")
+    if found.choice is None:
+        return 1
+    if args.write:
+        write_run_block(args.scene, found)
+        print(f"wrote the [run] block into {args.scene}")
+    else:
+        print("\n" + found.run_block().rstrip())
+    return 0
+
+
 def batch(args):
     """``hydrofmu batch``: exit 0 when every case ran, 1 when some failed."""
     try:
@@ -250,6 +288,24 @@ def make_parser():
     r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")
     r.add_argument("--transient", type=float, default=0.0, metavar="T",
                    help="the summary's statistics leave out t < T [s]")
+    t = sub.add_parser("tune", formatter_class=fmt, help="the cheapest run settings of a scene within a tolerance",
+                       description="Run a reference of the scene (the reference preset, checked by one halving), "
+                                   "search step, algorithm, load hold, substep and memory evaluator for the cheapest "
+                                   "settings whose error on the named outputs stays within the tolerance, print the "
+                                   "choice against the presets (error, cost, timing spread) and its [run] block; "
+                                   "draw every point run in a PNG.  See docs/tuning.md.")
+    t.add_argument("scene", type=Path, metavar="SCENE", help="scene file (.toml)")
+    t.add_argument("--tolerance", default="0.5%", metavar="TOL",
+                   help="largest error: normalised RMS over each output's range, '0.5%%' or 0.005")
+    t.add_argument("--outputs", nargs="+", metavar="NAME",
+                   help="what the error is measured on: body names, body.position (attitude, velocity, "
+                        "acceleration) or instance.variable columns (default: every body's position and attitude)")
+    t.add_argument("--window", type=float, metavar="T", help="simulated time of each run [s] (default: the "
+                                                            "scene's stop, at most 60 s)")
+    t.add_argument("--repeats", type=int, default=3, help="interleaved timing rounds of the final candidates")
+    t.add_argument("--png", type=Path, metavar="FILE", help="plot of the points run (default: build/tune/<scene>.png)")
+    t.add_argument("--write", action="store_true", help="write the choice into the scene's [run] table (the rest "
+                                                       "of the file kept)")
     a = sub.add_parser("batch", formatter_class=fmt,
                        description="Run a matrix of load cases (a case file: a scene and the values to vary) on Dask: one table of results (cases.csv, cases.parquet) and plots; exit code 1 when a case failed.",
                        help="run a matrix of load cases (a case file) on Dask: one table, plots")
@@ -362,6 +418,8 @@ def _main(argv):
         wrote, code = _wrote(result)
         print(f"ran {folder.name}: {len(result.time) - 1} steps; {wrote}")
         return code
+    elif args.command == "tune":
+        return tune(args)
     elif args.command == "batch":
         return batch(args)
     elif args.command == "demo":

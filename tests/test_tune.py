@@ -1,0 +1,94 @@
+"""hydrofmu tune on every scene of models/ at two tolerances: the settings it chooses meet the
+tolerance against an independent fine run (not the tune's own reference: half its step,
+computed here), and cost no more than the cheapest preset that meets it (measured
+cost within the measured spread, or the deterministic step count no larger)."""
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import hydrofmu
+from hydrofmu.cosim import inprocess
+from hydrofmu.cosim.master import run
+from hydrofmu.errors import InputError
+from hydrofmu.scene import load_scene
+from hydrofmu.tuning import write_run_block
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+# short windows keep the test small; side_by_side's convolution reference is the slow one
+WINDOWS = {"moored_barge": 10.0, "joined_barges": 4.0, "side_by_side": 1.0}
+TOLERANCES = (0.01, 0.002)
+
+
+def fine_run(path, window, columns):
+    """Gauss–Seidel, linear hold, step 0.0025 s, substep 0.00125 s, full convolution."""
+    scene = load_scene(path, {"run.stop": window, "run.step": 0.0025, "run.substep": 0.00125,
+                              "run.algorithm": "gauss-seidel", "run.load_hold": "linear", "run.preset": "reference"})
+    r = run(inprocess.system(scene), stop=window, record=columns, progress=False)
+    return r.time, r.values
+
+
+def recorded(cache, setting):
+    """The tune's own run of ``setting`` (times, all its columns): deterministic, so not rerun."""
+    runs = next(v for k, v in cache.items() if k[0] == "runs")
+    return runs[setting][:2]
+
+
+def error(t, y, tf, yf):
+    """√mean((y − y_fine)²) / ptp(y_fine), largest over the columns: computed here, from the fine run."""
+    ref = yf[np.rint(t / (tf[1] - tf[0])).astype(int)]
+    return float(np.max(np.sqrt(np.mean((y - ref) ** 2, axis=0)) / np.ptp(yf, axis=0)))
+
+
+@pytest.mark.parametrize("name", sorted(WINDOWS))
+def test_tune_meets_the_tolerance_at_no_more_cost_than_a_preset(name, tmp_path):
+    path, window, cache = MODELS / f"{name}.toml", WINDOWS[name], {}
+    fine = None
+    for tol in TOLERANCES:
+        found = hydrofmu.tune(path, tol, window=window, repeats=2 if name == "moored_barge" else 1,
+                              log=lambda s: None, _cache=cache,
+                              png=tmp_path / f"{tol}.png")
+        assert found.choice is not None, found.report()
+        assert (tmp_path / f"{tol}.png").stat().st_size > 10_000
+        if fine is None:
+            fine = fine_run(path, window, found.outputs)
+        keep = [found.columns.index(c) for c in found.outputs]
+        t, y = recorded(cache, found.choice.setting)
+        got = error(t, y[:, keep], *fine)
+        assert got <= tol, (name, tol, got, found.choice.setting)
+        presets = [p for p in found.points if {"screening", "design", "reference"} & set(p.source.split(" = "))]
+        assert {n for p in presets for n in p.source.split(" = ")} >= {"design", "reference"}
+        for p in presets:
+            t, y = recorded(cache, p.setting)
+            if error(t, y[:, keep], *fine) <= tol:
+                spread = max(found.choice.spread or 0, p.spread or 0)
+                assert found.choice.cost <= p.cost * (1 + spread) or found.choice.proxy <= p.proxy, (p.source, tol)
+        text = "\n".join(found.report())
+        assert "choice" in text and "not tried" in text and "ECCO" in text
+
+
+def test_tune_writes_the_run_block_and_keeps_the_rest(tmp_path):
+    shutil.copytree(MODELS / "decks", tmp_path / "decks")
+    path = tmp_path / "moored_barge.toml"
+    original = (MODELS / "moored_barge.toml").read_text()
+    path.write_text(original)
+    found = hydrofmu.tune(path, 0.01, window=10.0, repeats=1, log=lambda s: None)
+    write_run_block(path, found)
+    scene = load_scene(path)
+    s = found.choice.setting
+    assert (scene.run["step"], scene.run["algorithm"], scene.run["load_hold"], scene.run["substep"]) == \
+        (s.step, s.algorithm, s.load_hold, s.substep)
+    assert scene.run["stop"] == 600.0   # the scene's own stop kept
+    text = path.read_text()
+    before, after = original.split("[run]")[0], original.split("[bodies.barge]")[1]
+    assert text.startswith(before) and text.endswith(after)
+
+
+def test_tune_refuses_bad_input():
+    with pytest.raises(InputError, match=r"did you mean 'barge.position'"):
+        hydrofmu.tune(MODELS / "moored_barge.toml", 0.01, outputs=["barge.positon"], window=2.0)
+    with pytest.raises(InputError, match="tolerance"):
+        hydrofmu.tune(MODELS / "moored_barge.toml", 5.0)
+    with pytest.raises(InputError, match="window"):
+        hydrofmu.tune(MODELS / "moored_barge.toml", 0.01, window=1e4)
