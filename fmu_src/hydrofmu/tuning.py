@@ -189,8 +189,9 @@ class _Runner:
             if k in (1, n):
                 marks[k] = time.perf_counter()
         try:
+            # every communication point compared, whatever the scene's [run] interval
             result = run(system, stop=self.window, step=setting.step, algorithm=setting.algorithm,
-                         record=self.columns, progress=False, on_step=mark)
+                         record=self.columns, progress=False, on_step=mark, interval=setting.step)
         except RuntimeError as exc:   # the run failed (diverged): a point that meets nothing
             return None, str(exc), float("nan")
         finally:
