@@ -153,18 +153,19 @@ def test_outputs_checked_writable_before_the_run(tmp_path, demo_build, monkeypat
 
 
 def test_a_write_failing_after_the_run_keeps_the_results(tmp_path, demo_build, monkeypatch):
-    """The CSV's folder fills up after the run: the CSV goes to the current folder, the
-    warning says where, the exit code is 1 (not where asked), never 3."""
-    from hydrofmu.cosim.result import Result
+    """The CSV, streamed during the run, cannot be put in its folder after it (the folder
+    filled up): it goes to the current folder, the warning says where, the exit code is 1
+    (not where asked), never 3."""
+    from hydrofmu.cosim import stream
     asked = tmp_path / "out" / "r.csv"
     asked.parent.mkdir()
-    real = Result.to_csv
+    real = stream._move
 
-    def full(self, path):
-        if Path(path) == asked:
-            raise OSError(28, "No space left on device", str(path))
-        return real(self, path)
-    monkeypatch.setattr(Result, "to_csv", full)
+    def full(part, target):
+        if Path(target) == asked:
+            raise OSError(28, "No space left on device", str(target))
+        return real(part, target)
+    monkeypatch.setattr(stream, "_move", full)
     here = tmp_path / "here"
     here.mkdir()
     monkeypatch.chdir(here)

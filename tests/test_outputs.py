@@ -116,7 +116,8 @@ def test_run_writes_csv_png_and_summary_next_to_the_build_and_says_where(tmp_pat
     assert done.returncode == 0, done.stderr
     csv, png, summary = out / "moored_barge.csv", out / "moored_barge.png", out / "moored_barge.summary.json"
     assert f"in {out / 'moored_barge'}" in done.stdout             # where it built
-    assert f"wrote {csv}, {png} and {summary}" in done.stdout       # where it wrote
+    parquet = out / "moored_barge.parquet"
+    assert f"wrote {csv}, {parquet}, {png} and {summary}" in done.stdout       # where it wrote
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     result = read_csv(csv)
     assert len(result.time) == 11

@@ -6,6 +6,7 @@ Public API (imported on first use, so ``import hydrofmu`` stays cheap):
 - ``build(scene, out) -> Path``: build its FMUs into ``out/<scene name>/``;
 - ``run(scene_or_folder, stop=..., step=...) -> Result``: build if needed and run;
 - ``tune(scene, tolerance) -> Tuning``: the cheapest run settings within a tolerance;
+- ``read_parquet(path)``: the Parquet file a streamed run wrote, columns read when asked;
 - ``Result`` (``to_csv``, ``plot``, ``motion``, ``vector``) and ``read_csv``;
 - ``run_batch(cases, out) -> DataFrame``: a matrix of load cases on Dask, one row per
   case, and ``read_series(out, case)`` (the ``batch`` extra);
@@ -28,7 +29,7 @@ __version__ = "0.1.0"
 _WHERE = {
     "load_scene": "api", "Scene": "scene", "InputError": "errors",
     "build": "api", "run": "api", "tune": "tuning", "Tuning": "tuning", "run_batch": "batch", "read_series": "batch",
-    "Result": "cosim.result", "read_csv": "cosim.result",
+    "Result": "cosim.result", "read_csv": "cosim.result", "read_parquet": "cosim.stream",
     "ViscousDrag": "physics.viscous_drag", "CurrentPolar": "physics.current_polar",
     "LumpedBody": "physics.lumped", "BallJoint": "physics.joint", "Coupling": "physics.coupling",
     "Convolution": "physics.memory", "StateSpace": "physics.memory", "BodyLoads": "physics.loads",

@@ -105,3 +105,14 @@ def whole_steps(stop, step):
         return 0, [("stop", f"stop {stop:g} s is not a whole number of steps of {step:g} s ({ratio:.6g} steps): "
                             f"use stop {lo * step:.10g} or {hi * step:.10g} s, or a step that divides {stop:g} s")]
     return n, []
+
+
+def whole_interval(interval, step):
+    """(communication points per output row, problems) of an output ``interval`` [s]: a whole
+    number ≥ 1 of steps ``step`` [s]; problems name the field ``interval``."""
+    ratio = interval / step
+    every = round(ratio)
+    if every < 1 or abs(ratio - every) > STEPS_TOL * max(1.0, ratio):
+        return 1, [("interval", f"the output interval must be a whole number of steps ({step:g} s), "
+                                f"found {interval:g} s")]
+    return int(every), []

@@ -141,6 +141,8 @@ def built_folder(path: str | Path, out: str | Path = DEFAULT_OUT) -> Path | None
 def run(source: str | Path | Scene, *, stop: float | None = None, step: float | None = None,
         algorithm: str | None = None, engine: str | None = None, out: str | Path = DEFAULT_OUT,
         record: Sequence[str] | None = None, parameters: Mapping[str, float] | None = None,
+        outputs: Sequence[str] | None = None, interval: float | None = None,
+        parquet: str | Path | None = None, csv: str | Path | None = None,
         log: Callable[[str], object] = print) -> Result:
     """Run a scene: one call from a scene file (built first) or a built folder to a Result.
 
@@ -167,6 +169,16 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
         ``'instance.variable'`` outputs to record (default: every output of every FMU).
     parameters : mapping, optional
         ``{'instance.variable': value}`` set in initialization mode (fmpy engine).
+    outputs : sequence of str, optional
+        What to record by name (fmpy engine): body names (position and attitude),
+        ``body.position`` (``attitude``, ``velocity``, ``acceleration``) or
+        ``instance.variable``; default: the scene's ``[run] outputs``, else every output.
+    interval : float, optional
+        Output interval [s], a whole number of steps (fmpy engine); default: the scene's
+        ``[run] interval``, else every step.
+    parquet, csv : str or Path, optional
+        Stream the rows into these files as the run goes (fmpy engine; bounded memory): the
+        Result is then a ``cosim.stream.FileResult`` reading its columns from the Parquet file.
     log : callable, default print
         Receives the build's lines when a scene file is built, or the line saying which
         build is reused.
@@ -213,10 +225,16 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     from .cosim.libcosim import engine_for
     engine = engine_for(folder, algorithm, engine)
     if engine == "libcosim":
+        for key, value in (("outputs", outputs), ("interval", interval), ("parquet", parquet), ("csv", csv)):
+            if value is not None:
+                raise InputError("run", None, key, "the libcosim engine records every output at every step in "
+                                                   "memory: use engine='fmpy'")
         from .cosim.libcosim import run as run_libcosim
         return run_libcosim(folder, stop=stop, step=step, record=record, algorithm=algorithm)
     from .cosim.master import run as run_fmpy
-    return run_fmpy(folder, stop=stop, step=step, algorithm=algorithm, record=record, parameters=parameters)
+    from .cosim.stream import Sink
+    return run_fmpy(folder, stop=stop, step=step, algorithm=algorithm, record=record, parameters=parameters,
+                    outputs=outputs, interval=interval, sink=Sink(parquet, csv) if parquet or csv else None)
 
 
 def outputs(folder: str | Path) -> tuple[Path, Path]:

@@ -81,12 +81,15 @@ def _stderr(text):
     print(text, file=sys.stderr)
 
 
-def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=0.0, log=_stderr, say=print, **kw):
+def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=0.0, log=_stderr, say=print,
+               parquet=None, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
     an ECCO run, else fmpy), its settings said once first (``say``); write CSV/PNG and the
-    summary's JSON (checked writable first; a write that fails after the run goes to a
-    fallback folder: ``written`` maps each asked path to the one written).  The Result's
-    ``stats`` is its summary over t ≥ ``transient``."""
+    summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
+    t ≥ ``transient``.  fmpy runs stream their rows into the CSV and ``parquet`` (default:
+    beside the CSV when pyarrow is installed) as they go, and the PNG and the summary are
+    read from the file; a libcosim run is written after it ends.  A write that fails after
+    the run goes to a fallback folder: ``written`` maps each asked path to the one written."""
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
     folder = Path(folder)
@@ -98,17 +101,65 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
+        for key in ("outputs", "interval"):
+            if kw.pop(key, None) is not None:
+                raise InputError("command line", None, f"--{key}", "the libcosim engine records every output at "
+                                                                   "every step: use --engine fmpy")
         from .cosim.libcosim import run
-    else:
-        from .cosim.master import run
+        say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
+        result = run(folder, **kw)
+        result.stats = result.summary(transient)
+        result.written = {}
+        for path, write in ((csv, result.to_csv), (png, result.plot), (summary, result.stats.to_json)):
+            if path:
+                result.written[Path(path)] = keep(write, path, log)[0]
+        return result
+    from .cosim.master import run
+    from .cosim.stream import Sink
+    if parquet is None and csv is not None and _has_pyarrow():
+        parquet = Path(csv).with_suffix(".parquet")
+    check_outputs(files=(parquet,))
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
-    result = run(folder, **kw)
-    result.stats = result.summary(transient)
-    result.written = {}
-    for path, write in ((csv, result.to_csv), (png, result.plot), (summary, result.stats.to_json)):
-        if path:
-            result.written[Path(path)] = keep(write, path, log)[0]
+    try:
+        result = run(folder, sink=Sink(parquet, csv) if parquet or csv else None, **kw)
+    except InputError as exc:   # the run's own --outputs/--interval, named as the command line says them
+        if exc.path == "run" and exc.field in ("outputs", "interval"):
+            raise InputError("command line", None, f"--{exc.field}", exc.message) from None
+        raise
+    result.written = {Path(asked): Path(got) for asked, got in getattr(result, "written", {}).items()}
+    missing = _unplotted(result)
+    if png and missing:
+        log(f"warning: no PNG: the plot needs every output of the bodies' FMUs, and {missing} was not "
+            "recorded (--outputs / [run] outputs)")
+    elif png:
+        result.written[Path(png)] = keep(result.plot, png, log)[0]
+    result.stats = result.summary(transient) if not missing else None
+    if summary and result.stats is not None:
+        result.written[Path(summary)] = keep(result.stats.to_json, summary, log)[0]
     return result
+
+
+def _unplotted(result):
+    """The first output the run's plot needs that ``result`` did not record, or None."""
+    from .cosim.stream import plot_columns
+    have = set(result.columns)
+    return next((c for c in plot_columns(result.manifest) if c not in have), None)
+
+
+def _steps(result):
+    """'N steps' of a run, with the rows written when an output interval thinned them."""
+    n = len(result.time) - 1
+    steps = round(result.settings["stop"] / result.settings["step"]) if result.settings and \
+        result.settings.get("algorithm") != "ecco" else n
+    return f"{steps} steps" + (f", {n + 1} rows written" if steps != n else "")
+
+
+def _has_pyarrow():
+    try:
+        import pyarrow.parquet  # noqa: F401  (the batch extra)
+    except ImportError:
+        return False
+    return True
 
 
 def _wrote(result):
@@ -266,12 +317,13 @@ def make_parser():
                                                          "write nothing")
     r = sub.add_parser("run", formatter_class=fmt, help="run a scene (a .toml is built first) or a built scene folder",
                        description="Run a scene and write its results: the CSV (header 'instance.variable "
-                                   "[unit]', one row per communication point) and the PNG (motion from the initial "
-                                   "pose, every load, joint gaps) next to the built folder, <folder>.csv and "
-                                   "<folder>.png, unless --csv/--png say otherwise, and the summary (mean, std, "
-                                   "min, max of each body's motion and loads per dof, with units): printed and "
-                                   "written as <folder>.summary.json.  A scene file whose build in OUT is up to "
-                                   "date is not built again.  Step, stop and algorithm "
+                                   "[unit]', one row per output point) and Parquet files, written as the run goes "
+                                   "(bounded memory), and the PNG (motion from the initial pose, every load, joint "
+                                   "gaps) drawn from the file, next to the built folder: <folder>.csv, "
+                                   "<folder>.parquet, <folder>.png, unless --csv/--parquet/--png say otherwise, and "
+                                   "the summary (mean, std, min, max of each body's motion and loads per dof, with "
+                                   "units): printed and written as <folder>.summary.json.  A scene file whose build "
+                                   "in OUT is up to date is not built again.  Step, stop and algorithm "
                                    "default to the scene's [run] settings (its preset's).")
     r.add_argument("scene", metavar="SCENE", help="scene file (.toml, built into OUT first) or built scene folder")
     r.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="where a .toml scene is built")
@@ -288,6 +340,15 @@ def make_parser():
     r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")
     r.add_argument("--transient", type=float, default=0.0, metavar="T",
                    help="the summary's statistics leave out t < T [s]")
+    r.add_argument("--parquet", type=Path, metavar="FILE",
+                   help="Parquet file to write (default: <folder>.parquet, when pyarrow is installed)")
+    r.add_argument("--outputs", nargs="+", metavar="NAME",
+                   help="what to record: body names (position, attitude), body.position (attitude, velocity, "
+                        "acceleration), instance.variable columns (default: the scene's [run] outputs, else every "
+                        "output)")
+    r.add_argument("--interval", type=float, metavar="S",
+                   help="output interval [s], a whole number of steps (default: the scene's [run] interval, "
+                        "else every step)")
     t = sub.add_parser("tune", formatter_class=fmt, help="the cheapest run settings of a scene within a tolerance",
                        description="Run a reference of the scene (the reference preset, checked by one halving), "
                                    "search step, algorithm, load hold, substep and memory evaluator for the cheapest "
@@ -337,7 +398,7 @@ def make_parser():
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "stability", "bem", "robust", "batch",
-                            "ecco"),
+                            "ecco", "longrun"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="small sizes: a 1-minute smoke run, not the README figures")
     m = sub.add_parser("bem2simo", formatter_class=fmt,
@@ -412,11 +473,14 @@ def _main(argv):
             folder = next(iter(build([scene], args.out).values()))
         csv, png = outputs(folder)
         csv, png = args.csv or csv, args.png or png
+        extra = {k: v for k, v in (("outputs", args.outputs), ("interval", args.interval)) if v is not None}
         result = run_folder(folder, args.engine, csv, png, folder.with_name(folder.name + ".summary.json"),
-                            args.transient, stop=args.stop, step=args.step, algorithm=args.algorithm)
-        print(result.stats)
+                            args.transient, parquet=args.parquet, stop=args.stop, step=args.step,
+                            algorithm=args.algorithm, **extra)
+        if result.stats is not None:
+            print(result.stats)
         wrote, code = _wrote(result)
-        print(f"ran {folder.name}: {len(result.time) - 1} steps; {wrote}")
+        print(f"ran {folder.name}: {_steps(result)}; {wrote}")
         return code
     elif args.command == "tune":
         return tune(args)
@@ -437,7 +501,7 @@ def _main(argv):
             result = run_folder(folders[name], "fmpy", csv, png, folders[name].with_name(name + ".summary.json"))
             wrote, failed = _wrote(result)
             code = max(code, failed)
-            print(f"ran {name}: {len(result.time) - 1} steps; {wrote} (the summary: mean, std, min, max "
+            print(f"ran {name}: {_steps(result)}; {wrote} (the summary: mean, std, min, max "
                   f"per body and dof)")
         return code
     elif args.command == "bem2simo":

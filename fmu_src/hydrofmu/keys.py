@@ -78,6 +78,9 @@ RUN = {
     "substep": (POSITIVE, "accuracy of the dynamics partner [s]: internal steps ≤ 5·substep"),
     "load_hold": (enum("constant", "linear"), "how the dynamics hold a load input over a step"),
     "ecco": ({"table": ECCO}, "libcosim's ECCO settings (algorithm = \"ecco\")"),
+    "outputs": ({**NAMES, "minItems": 1}, "what hydrofmu run records: body names, body.position (attitude, velocity, "
+                                          "acceleration), instance.variable (default: every output)"),
+    "interval": (POSITIVE, "output interval [s], a whole number of steps (default: every step)"),
 }
 
 LUMPED = {

@@ -386,6 +386,22 @@ PRESETS = {
 }
 
 
+# what a run writes (not run knobs: no preset sets them): `outputs`, names of what to record
+# (body names, body.position …, instance.variable; default every output), `interval`, the
+# output interval [s] (a whole number of steps; default every step)
+OUTPUT_KEYS = ("outputs", "interval")
+
+
+def _outputs(p, run):
+    value = run.get("outputs")
+    if value is not None and (not isinstance(value, list) or not value
+                              or not all(isinstance(v, str) and v for v in value)):
+        p.add("run.outputs", f"expected a non-empty array of output names (e.g. [\"barge\", \"barge.force[1]\"]), "
+                             f"found {value!r}")
+        return None
+    return value
+
+
 def _ecco(p, run, base, step):
     """The ECCO settings of ``[run.ecco]`` over the preset's (or the defaults), checked."""
     table = p.table(run, "ecco", "run.ecco", required=False) or {}
@@ -725,11 +741,16 @@ def _load_scene(path, overrides=None):
         "substep": p.number(run, "substep", "run.substep", base["substep"], positive=True),
         "load_hold": p.choice(run, "load_hold", "run.load_hold", ("constant", "linear"), base["load_hold"]),
         "memory": dict(base.get("memory", MEMORY_DEFAULTS)),
-        "set": sorted(k for k in run if k != "preset"),   # knobs the scene sets itself
+        "set": sorted(k for k in run if k != "preset" and k not in OUTPUT_KEYS),   # knobs the scene sets itself
+        "outputs": _outputs(p, run),
+        "interval": p.number(run, "interval", "run.interval", positive=True) if "interval" in run else None,
     }
     run_cfg["ecco"] = _ecco(p, run, base, run_cfg["step"] if run_cfg["algorithm"] == "ecco" else None)
     if run_cfg["algorithm"] not in (None, "ecco") and None not in (run_cfg["step"], run_cfg["stop"]):
         for field_, message in admissible.whole_steps(run_cfg["stop"], run_cfg["step"])[1]:
+            p.add(f"run.{field_}", message)
+    if run_cfg["interval"] is not None and run_cfg["step"] and run_cfg["algorithm"] != "ecco":
+        for field_, message in admissible.whole_interval(run_cfg["interval"], run_cfg["step"])[1]:
             p.add(f"run.{field_}", message)
     if "ecco" in run and run_cfg["algorithm"] not in (None, "ecco"):
         p.add("run.ecco", f"ECCO settings need algorithm = \"ecco\" (the run's algorithm is {run_cfg['algorithm']!r})")

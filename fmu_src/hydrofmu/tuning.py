@@ -44,7 +44,6 @@ import numpy as np
 
 from .admissible import whole_steps
 from .errors import InputError
-from .names import unknown
 
 # communication steps searched [s]: multiples of the reference's 0.005 s
 STEPS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
@@ -54,7 +53,6 @@ MEMORY = {"screening": "state-space tol 0.05", "design": "state-space tol 0.01",
 ALGORITHMS = ("gauss-seidel", "jacobi")
 HOLDS = ("linear", "constant")
 WINDOW = 60.0   # default tuning window [s]: the first minute of the scene's run
-MOTION = ("position", "attitude")
 
 
 @dataclass(frozen=True)
@@ -163,21 +161,6 @@ def _short(names, show=6):
     return ", ".join(names[:show]) + (f", … ({len(names) - show} more)" if len(names) > show else "")
 
 
-def _columns(manifest, outputs):
-    """Recorded columns of the named outputs: body names (position and attitude), ``body.position``
-    (or attitude, velocity, acceleration), or ``instance.variable`` columns."""
-    dynamics = manifest["dynamics"]
-    cols = []
-    for name in outputs or list(dynamics):
-        body, _, what = name.partition(".")
-        if body in dynamics and (not what or what in ("position", "attitude", "velocity", "acceleration")):
-            inst, prefix = dynamics[body]
-            cols += [f"{inst}.{prefix}{w}[{i}]" for w in ([what] if what else MOTION) for i in (1, 2, 3)]
-        else:
-            cols.append(name)
-    return list(dict.fromkeys(cols))
-
-
 class _Runner:
     """Runs settings of one scene in this process over the window; caches errors."""
 
@@ -194,14 +177,11 @@ class _Runner:
         scene = load_scene(self.path, setting.overrides(self.window))
         system = inprocess.system(scene)
         if self.manifest is None:
+            from .cosim.stream import select
             self.manifest, self.instances = system.manifest, len(system.instances)
-            self.columns = _columns(system.manifest, self.outputs)
             valid = [f"{n}.{v}" for n, inst in system.instances.items() for v in inst.outputs()]
-            for col in self.columns:
-                if col not in valid:
-                    bodies = list(system.manifest["dynamics"])
-                    named = bodies + [f"{b}.{w}" for b in bodies for w in MOTION + ("velocity", "acceleration")]
-                    raise InputError(self.path, None, "outputs", unknown("output", col, named + valid))
+            self.columns = select(system.manifest, self.outputs or list(system.manifest["dynamics"]), valid,
+                                  self.path, "outputs")
         marks = {}
         n = int(round(self.window / setting.step))
 
@@ -209,8 +189,9 @@ class _Runner:
             if k in (1, n):
                 marks[k] = time.perf_counter()
         try:
+            # every communication point compared, whatever the scene's [run] interval
             result = run(system, stop=self.window, step=setting.step, algorithm=setting.algorithm,
-                         record=self.columns, progress=False, on_step=mark)
+                         record=self.columns, progress=False, on_step=mark, interval=setting.step)
         except RuntimeError as exc:   # the run failed (diverged): a point that meets nothing
             return None, str(exc), float("nan")
         finally:

@@ -20,6 +20,8 @@ Parts (each also callable alone, see ``PARTS``):
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
   case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
   took against the bonds' power (``ecco_cost``)
+- longrun: peak memory and wall time of a 3-hour side_by_side run (216 000 steps), streamed to
+  Parquet + CSV against held in memory, each in a fresh process (``longrun``)
 
 ``quick`` shrinks every part (for a smoke run); the figures in the README come from a full run.
 """
@@ -429,9 +431,27 @@ def batch_lines(s, cases):
             f"dispatch overhead per case: {overhead}; fixed cost of a batch (plan, table, plot): {s['fixed_s']:.2f} s"]
 
 
+def part_longrun(out, quick):
+    from . import longrun
+    # quick: a smoke run of the streamed path only, not the 3-hour figures
+    stop = 300.0 if quick else 10800.0
+    rows = longrun.measure(out / "longrun", stop, ("stream",) if quick else ("floor", "stream", "memory"))
+    write_csv(out / "longrun.csv", rows)
+    by = {r["mode"]: r for r in rows}
+    s = by["stream"]
+    line = (f"{s['steps']} steps of side_by_side ({stop / 3600:g} h): streamed peak {s['peak_mb']:.0f} MB "
+            f"(its plot's process {s['child_peak_mb']:.0f} MB), {s['wall_s']:.0f} s, files {s['written_mb']:.0f} MB "
+            f"(Parquet + CSV + PNG)")
+    if "memory" in by:
+        m, f = by["memory"], by["floor"]
+        line += (f"; in memory peak {m['peak_mb']:.0f} MB, {m['wall_s']:.0f} s, {m['written_mb']:.0f} MB (CSV + PNG); "
+                 f"FMUs loaded only: {f['peak_mb']:.0f} MB")
+    return [line]
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "stability": part_stability, "bem": part_bem,
-         "robust": part_robust, "batch": part_batch, "ecco": part_ecco}
+         "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun}
 
 
 def main(out, parts=None, quick=False, log=print):

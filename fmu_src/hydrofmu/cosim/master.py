@@ -339,11 +339,17 @@ def _check_algorithm(algorithm, where):
 
 
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
-        on_step=None):
+        on_step=None, outputs=None, interval=None, sink=None):
     """Run a built scene (its folder), or a loaded ``System`` (initialised here, left loaded
     for the caller to free; ``parameters`` are then the System's own); returns a Result.
 
-    ``record``: 'instance.variable' columns (default: every output of every FMU).
+    ``record``: 'instance.variable' columns (default: ``outputs``, else every output of every FMU).
+    ``outputs``: output names (``cosim.stream.select``: body names, ``body.position``, …,
+    ``instance.variable``; default: the scene's ``[run] outputs``).
+    ``interval``: output interval [s], a whole number of steps (default: the scene's
+    ``[run] interval``, else every step).
+    ``sink``: a ``cosim.stream.Sink``: rows streamed to its files as the run goes (bounded
+    memory) and a ``FileResult`` (read from the Parquet file) returned, when it has one.
     ``parameters``: {'instance.variable': value} set in initialization mode.
     ``progress``: print a progress line to stderr (default: when more than 2000 steps).
     ``on_step``: called with the step count after each communication step (benchmarks).
@@ -362,14 +368,28 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         _check_algorithm(algorithm, system.manifest.get("source", "run"))
         n = check_steps(stop, step, algorithm, "run")
         variables = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.vr]
+        where, field = ("run", "outputs") if outputs is not None else (system.manifest.get("source", "run"),
+                                                                       "run.outputs")
+        outputs = cfg.get("outputs") if outputs is None and record is None else outputs
+        if record is None and outputs:
+            from .stream import select
+            record = select(system.manifest, outputs, [f"{name}.{v}" for name, inst in system.instances.items()
+                                                       for v in inst.outputs()], where, field)
         if record is None:
             record = [f"{name}.{v}" for name, inst in system.instances.items() for v in inst.outputs()]
         check_names(record, variables, "run", "record", "'instance.variable'")
+        from .stream import Recorder, output_every
+        thin = output_every(*((interval, step) if interval is not None else (cfg.get("interval"), step,
+                                                                              system.manifest.get("source", "run"),
+                                                                              "run.interval")))
         if own:
             check_names(system.parameters, [f"{name}.{v}" for name, inst in system.instances.items()
                                             for v, c in inst.causality.items() if c in ("parameter", "input")],
                         "run", "parameters", "parameter or input")
-        values = np.empty((n + 1, len(record)))
+        settings = run_settings(system.manifest, step, algorithm, stop)
+        rows = Recorder(n, step, len(record), thin, sink)
+        if sink is not None:
+            sink.open(record, system.units(record), system.manifest, {**settings, "output_interval": thin * step})
         progress = n > 2000 if progress is None else progress
         tty = sys.stderr.isatty()
         every = max(1, n // (20 if tty else 4))  # a live line on a terminal, four lines in a log
@@ -380,7 +400,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         if algorithm != "jacobi":
             system.resolve(order)
         exchange.read_all()
-        exchange.sample(values[0])
+        exchange.sample(rows.row(0))
         t0 = clock.perf_counter()
         for k in range(n):
             t = k * step
@@ -388,10 +408,11 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 inst.do_step(t, step)
             if algorithm == "jacobi":
                 exchange.jacobi()  # sampled before the exchange, as libcosim's observers see it
-                exchange.sample(values[k + 1])
             else:
                 exchange.resolve(order)
-                exchange.sample(values[k + 1])
+            row = rows.row(k + 1)
+            if row is not None:
+                exchange.sample(row)
             if on_step is not None:
                 on_step(k + 1)
             if progress and (k + 1) % every == 0:
@@ -402,12 +423,25 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                 sys.stderr.flush()
         if progress and tty:
             sys.stderr.write("\n")
-        return Result(np.arange(n + 1) * step, list(record), values, algorithm, step, system.manifest["dynamics"],
-                      run_settings(system.manifest, step, algorithm, stop),
-                      system.units(record), system.manifest)
+        if sink is not None:
+            rows.flush()
+            sink.close()
+            done, sink = sink, None
+            if done.parquet:
+                from .stream import read_parquet
+                result = read_parquet(done.written[done.parquet])
+            else:
+                from .result import read_csv
+                result = read_csv(done.written[done.csv], system.manifest)
+            result.written = dict(done.written)
+            return result
+        return Result(np.arange(0, n + 1, thin) * step, list(record), rows.values, algorithm, thin * step,
+                      system.manifest["dynamics"], settings, system.units(record), system.manifest)
     except FMICallException as exc:
         raise RunError(failure(system, exc, t)) from None
     finally:
+        if sink is not None:   # the run failed: no half-written file under the asked name
+            sink.close(ok=False)
         if own:
             system.free()
 

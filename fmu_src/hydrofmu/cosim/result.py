@@ -104,7 +104,8 @@ class Result:
             if name in variables:
                 raise UnknownName("column", f"{instance}.{name}[{missing[0]}]", self.columns)
             raise UnknownName("variable", name, variables, f" of instance {instance!r}")
-        return np.column_stack([self.values[:, self._index[f"{instance}.{name}[{i}]"]] for i in range(1, n + 1)])
+        # column by column through __getitem__ (a FileResult reads each from its file)
+        return np.column_stack([self[f"{instance}.{name}[{i}]"] for i in range(1, n + 1)])
 
     def motion(self, body: str, name: str, n: int | None = None) -> np.ndarray:
         """(n_times, n) array of a body's dynamics output ``name[1..n]`` (``position``,
