@@ -36,6 +36,9 @@ KINDS = {description.LoadFMU: 0, description.ConnectorFMU: 1, description.Dynami
 CAUSALITY = {"parameter": "p", "calculatedParameter": "c", "input": "i", "output": "o"}
 WIN64_CC = "x86_64-w64-mingw32-gcc"
 FLAGS = ["-O2", "-shared", "-std=c99", "-s"]
+# physics/waves.c and the 'waves' record are written against the wave work in progress; a
+# compiled build refuses waves until tests/test_compiled.py holds them against the Python flavour
+WAVES_HELD = False
 
 
 def fmi_headers() -> Path:
@@ -94,6 +97,9 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     recs = [("kind", [KINDS[type(desc)]]), ("start", slave.values.tolist())]
     if isinstance(desc, description.LoadFMU):
         if getattr(desc, "waves", None) is not None:
+            if not WAVES_HELD:   # until a test holds physics/waves.c against the Python flavour
+                raise InputError(desc.description, None, "waves", "the waves have no compiled kernel yet: build "
+                                 "this scene with runtime = \"python\" ([build] runtime, or --runtime python)")
             recs += _waves(slave)
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave), _inputs(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]
