@@ -87,8 +87,7 @@ def _waves(slave):
     wave, name = slave.wave, slave.wave_cfg.name
     vr = {v.name: k for k, v in slave.vars.items()}
     fixed = [(r, slave.values[r]) for r in list(slave.wave_knobs.values()) + [slave.g]]
-    return [("waves", [vr[f"{name}.force[1]"], vr[f"{name}.elevation"], len(wave.omega), wave.ramp]
-             + wave.omega.tolist() + wave.table.ravel().tolist()),
+    return [("waves", [vr[f"{name}.force[1]"], vr[f"{name}.elevation"]] + wave.c_params()),
             ("waves_fixed", [float(x) for pair in fixed for x in pair])]
 
 
