@@ -50,7 +50,7 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
-          log: Callable[[str], object] = print) -> Path:
+          log: Callable[[str], object] = print, runtime: str | None = None) -> Path:
     """Build the FMUs of a scene.
 
     Parameters
@@ -65,6 +65,9 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
     log : callable, default print
         Receives one line per built FMU and the build's reports (fits, stability
         indicators); ``lambda s: None`` keeps it quiet.
+    runtime : {'python', 'c'}, optional
+        The FMUs' flavour: 'python' (pythonfmu, the reference) or 'c' (compiled, no
+        Python at run time); default the scene's ``[build] runtime``, else 'python'.
 
     Returns
     -------
@@ -82,7 +85,7 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
     if not isinstance(scene, Scene):
         inputs = inputs_hash(scene)
         scene = load_scene(scene)
-    return Path(build_scene(scene, Path(out), log=log, inputs=inputs))
+    return Path(build_scene(scene, Path(out), log=log, inputs=inputs, runtime=runtime))
 
 
 def _files_named(value, base):

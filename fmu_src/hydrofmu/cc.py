@@ -1,5 +1,5 @@
-"""The system C compiler, for hydrofmu's two small C parts: the FMI shim (fmi/shim.c) and
-the rigid-body kernel (physics/rigid.c).  Each source is compiled once per hash of its
+"""The system C compiler, for hydrofmu's C parts: the FMI shim (fmi/shim.c), the rigid-body
+kernel (physics/rigid.c) and the compiled FMUs (fmi/cbuild.py).  Each library is compiled once per hash of its
 text and flags into a cache folder ($HYDROFMU_CACHE, else $XDG_CACHE_HOME/hydrofmu, else
 ~/.cache/hydrofmu), under a private name renamed into place, so that concurrent builds
 (batch workers, parallel test processes) never see a partial library."""
@@ -43,19 +43,33 @@ def cache_dir() -> Path:
 def cached(source: Path, libs: list[str] = ()) -> Path:
     """The shared library of C file ``source`` (FLAGS, then ``libs`` after the source: link
     order matters with --as-needed), compiled unless the cache holds it already."""
-    source = Path(source)
-    key = hashlib.sha256(source.read_bytes() + " ".join(FLAGS + list(libs)).encode()).hexdigest()[:16]
-    lib = cache_dir() / f"{source.stem}-{key}.so"
+    return cached_many([Path(source)], Path(source).stem, libs=libs)
+
+
+def cached_many(sources: list[Path], name: str, libs: list[str] = (), flags: list[str] = FLAGS,
+                includes: list[Path] = (), cc: list[str] | None = None, suffix: str = ".so") -> Path:
+    """The library ``name`` of the C files ``sources`` (their hash and that of every header
+    next to them and in ``includes`` its key), compiled by ``cc`` (default ``compiler()``)
+    with ``flags``, then ``libs`` after the sources (link order matters with --as-needed),
+    unless the cache holds it already."""
+    sources = [Path(s) for s in sources]
+    cc = cc or compiler()
+    h = hashlib.sha256(" ".join(cc + list(flags) + list(libs)).encode())
+    for f in sources + sorted(p for d in {s.parent for s in sources} | {Path(i) for i in includes}
+                              for p in Path(d).glob("*.h")):
+        h.update(f.name.encode() + f.read_bytes())
+    lib = cache_dir() / f"{name}-{h.hexdigest()[:16]}{suffix}"
     if lib.is_file():
         return lib
     lib.parent.mkdir(parents=True, exist_ok=True)
-    cc = compiler()
-    fd, tmp = tempfile.mkstemp(prefix=lib.stem + ".", suffix=".so.tmp", dir=lib.parent)
+    fd, tmp = tempfile.mkstemp(prefix=lib.stem + ".", suffix=suffix + ".tmp", dir=lib.parent)
     os.close(fd)
     try:
-        run = subprocess.run(cc + FLAGS + [str(source), "-o", tmp] + list(libs), capture_output=True, text=True)
+        run = subprocess.run(cc + list(flags) + [f"-I{i}" for i in includes] + [str(s) for s in sources]
+                             + ["-o", tmp] + list(libs), capture_output=True, text=True)
         if run.returncode != 0:
-            raise RuntimeError(f"compiling {source} with {cc[0]} failed:\n{run.stderr.strip()}")
+            raise RuntimeError(f"compiling {', '.join(s.name for s in sources)} with {cc[0]} failed:\n"
+                               f"{run.stderr.strip()}")
         os.replace(tmp, lib)
     finally:
         if os.path.exists(tmp):

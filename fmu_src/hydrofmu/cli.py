@@ -35,9 +35,10 @@ def scenes_in(paths, models=None):
                      + ": name scene files, or run from a folder that has models/*.toml")
 
 
-def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
+def build(paths, outdir=DEFAULT_OUT, log=print, check=False, runtime=None):
     """Validate every scene (files or loaded Scenes) first, then build each one; returns
-    {scene name: folder} (``check``: every check of the build, nothing written; the folders are None)."""
+    {scene name: folder} (``check``: every check of the build, nothing written; the folders are None;
+    ``runtime``: 'python' or 'c', else each scene's [build] runtime)."""
     from .fmi.build import build_scene
     from .scene import Scene, load_scene
 
@@ -53,7 +54,8 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False):
         check_folder(outdir)
     folders = {}
     for s in scenes:   # the inputs' hash lets a later run of the same scene file reuse the build
-        folders[s.name] = build_scene(s, outdir, log=log, check=check, inputs=inputs_hash(s.path))
+        folders[s.name] = build_scene(s, outdir, log=log, check=check, inputs=inputs_hash(s.path),
+                                      runtime=runtime)
         if not check:
             log(f"built scene {s.name}: FMUs, manifest.json, OSP files and {s.name}.ssp in {folders[s.name]}")
     return folders
@@ -315,6 +317,9 @@ def make_parser():
     b.add_argument("-o", "--out", default=DEFAULT_OUT, type=Path, help="parent folder of the built scenes")
     b.add_argument("--check", action="store_true", help="check the scenes and their decks as the build does; "
                                                          "write nothing")
+    b.add_argument("--runtime", choices=("python", "c"), default=None,
+                   help="the FMUs' flavour: 'python' (pythonfmu, the reference) or 'c' (compiled: plain C, no "
+                        "Python at run time, C sources inside); default each scene's [build] runtime, else python")
     r = sub.add_parser("run", formatter_class=fmt, help="run a scene (a .toml is built first) or a built scene folder",
                        description="Run a scene and write its results: the CSV (header 'instance.variable "
                                    "[unit]', one row per output point) and Parquet files, written as the run goes "
@@ -453,7 +458,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 def _main(argv):
     args = make_parser().parse_args(argv)
     if args.command == "build":
-        for name in build(scenes_in(args.scenes), args.out, check=args.check):
+        for name in build(scenes_in(args.scenes), args.out, check=args.check, runtime=args.runtime):
             if args.check:
                 print(f"checked {name}: ok")
     elif args.command == "validate":

@@ -179,6 +179,10 @@ BEM_COUPLING = {
     **MEMORY,
 }
 
+BUILD = {
+    "runtime": (enum("python", "c"), "the FMUs' flavour: pythonfmu (the reference) or compiled C (no Python at run time)"),
+}
+
 SCENE = {
     "scene": ({"table": SCENE_META}, "name and description"),
     "environment": ({"table": ENVIRONMENT}, "water, gravity and current"),
@@ -188,6 +192,7 @@ SCENE = {
                "RIFLEX CONB joints: [joints.NAME]"),
     "couplings": ({"couplings": (COUPLING, BEM_COUPLING)},
                   "SIMO hydrodynamic couplings ([[couplings]]: deck + coupling, or bem)"),
+    "build": ({"table": BUILD}, "build settings (hydrofmu build)"),
 }
 
 CASES = {

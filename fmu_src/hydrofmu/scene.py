@@ -56,6 +56,7 @@ class Scene:
     current_profile: list = None     # [[z m, speed m/s, direction deg], ...] or None (uniform)
     warnings: list = field(default_factory=list)   # suspicious but legal input, said at load (InputWarning)
     decks: list = field(default_factory=list)   # decks.lines.Reading of each deck read: used, skipped, warnings
+    runtime: str = "python"          # [build] runtime: "python" (pythonfmu) or "c" (compiled)
 
 
 class Problems:
@@ -728,6 +729,9 @@ def _load_scene(path, overrides=None):
     p.known_keys(env, "environment", keys.names(keys.ENVIRONMENT))
     run = p.table(doc, "run", "run", required=False) or {}
     p.known_keys(run, "run", keys.names(keys.RUN))
+    build_t = p.table(doc, "build", "build", required=False) or {}
+    p.known_keys(build_t, "build", keys.names(keys.BUILD))
+    runtime = p.choice(build_t, "runtime", "build.runtime", RUNTIMES, "python")
     preset = run.get("preset")
     if preset is not None and preset not in PRESETS:
         p.add("run.preset", f"expected one of {', '.join(map(repr, PRESETS))}, found {preset!r}")
@@ -780,13 +784,14 @@ def _load_scene(path, overrides=None):
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
-        bodies=bodies, run=run_cfg, decks=p.readings,
+        bodies=bodies, run=run_cfg, decks=p.readings, runtime=runtime or "python",
     )
     p.raise_if_any()
     return scene
 
 
-SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
+SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build")
+RUNTIMES = tuple(keys.BUILD["runtime"][0]["enum"])   # [build] runtime: fmi/build.py, fmi/cbuild.py
 CURRENT_FORMATS = ("deeplines", "sima", "riflex")
 # keys that go with current_deck; the last three only with current_format = "riflex"
 CURRENT_DECK_KEYS = tuple(keys.CURRENT_DECK)

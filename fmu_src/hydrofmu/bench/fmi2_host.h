@@ -4,7 +4,6 @@
  * (tests/native/fmi_host.c, compiled with -I for this folder).  Declared here, ABI-compatible
  * with the standard headers, so the hosts build with nothing but a C compiler and libdl.
  */
-#include <dlfcn.h>
 #include <stdio.h>
 
 typedef void *C;
@@ -26,11 +25,17 @@ typedef struct {
     int (*DoStep)(C, double, double, int);
 } Fmi;
 
-/* dlopen DIR/binaries/linux64/ID.so and fill `fmi`: the handle, or NULL with the reason printed. */
-static void *fmi_load(const char *dir, const char *id, Fmi *fmi) {
-    static const char *names[] = {"fmi2Instantiate", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
+/* the members of Fmi, in order */
+static const char *fmi_names[] = {"fmi2Instantiate", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
                                   "fmi2ExitInitializationMode", "fmi2Terminate", "fmi2FreeInstance",
                                   "fmi2SetReal", "fmi2GetReal", "fmi2DoStep"};
+
+#ifndef _WIN32   /* (tests/native/win_host.c loads with LoadLibrary) */
+#include <dlfcn.h>
+
+/* dlopen DIR/binaries/linux64/ID.so and fill `fmi`: the handle, or NULL with the reason printed. */
+static void *fmi_load(const char *dir, const char *id, Fmi *fmi) {
+    const char **names = fmi_names;
     char lib[4200];
     snprintf(lib, sizeof lib, "%s/binaries/linux64/%s.so", dir, id);
     void *h = dlopen(lib, RTLD_NOW | RTLD_LOCAL);
@@ -39,7 +44,7 @@ static void *fmi_load(const char *dir, const char *id, Fmi *fmi) {
         return NULL;
     }
     void **slots = (void **)fmi; /* members are pointers in the order of names */
-    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+    for (size_t i = 0; i < sizeof fmi_names / sizeof *fmi_names; i++)
         if (!(slots[i] = dlsym(h, names[i]))) {
             printf("missing %s\n", names[i]);
             dlclose(h);
@@ -47,3 +52,4 @@ static void *fmi_load(const char *dir, const char *id, Fmi *fmi) {
         }
     return h;
 }
+#endif

@@ -36,7 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from . import cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust, stability  # noqa: E402
+from . import compiled, cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust, stability  # noqa: E402
 from .timing import over  # noqa: E402
 
 
@@ -330,7 +330,7 @@ def part_floor(out, quick):
                      + (f" (last/first {ratio:.2f}; 1 = linear in the pairs)" if len(marginal) > 1 else ""))
     elif noisy:
         lines.append(f"too noisy for the body-count trend ({', '.join(noisy)})")
-    return lines
+    return lines + compiled.part(out, quick, fmu)
 
 
 def part_native(out, quick):

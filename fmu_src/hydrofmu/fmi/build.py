@@ -255,16 +255,20 @@ def report_bem(scene, log, folder):
         log(f"  wrote {png.name}")
 
 
-def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None):
+def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None, runtime=None):
     """Build all FMUs of ``scene`` into ``outdir/<scene name>/``; returns that folder.
     The folder is replaced only when the whole build succeeded.  ``check``: stop before
     anything is written (every check of the build done), return None.  ``inputs``: recorded
-    in the manifest (see `manifest`)."""
+    in the manifest (see `manifest`).  ``runtime``: 'python' (pythonfmu) or 'c' (compiled,
+    fmi/cbuild.py); default the scene's ``[build] runtime``."""
     outdir = Path(outdir)
+    flavour = runtime or scene.runtime
+    if inputs is not None and flavour != scene.runtime:   # not the build a later run of the file would make
+        inputs = f"{inputs}+{flavour}"
     target = outdir / scene.name
     system = assemble(scene)
     fit_memories(scene.couplings)   # once, here: the FMUs load the stored fits
-    runtime = runtime_name()
+    runtime = runtime_name() if flavour == "python" else None   # None: the compiled flavour
     for line in notes(scene, system):
         log(line)
     if check:
@@ -290,7 +294,11 @@ def _build_into(scene, outdir, target, system, runtime, shim, log, inputs=None):
         for inst in system.instances:   # load and joint FMUs first: the dynamics start at their loads
             if inst.kind == "dynamics":
                 starts.fill_loads(system, t0)
-            fmu, slaves[inst.name], t0[inst.name] = build_fmu(inst, work, runtime, shim)
+            if runtime is None:   # the compiled flavour
+                from .cbuild import build_c_fmu
+                fmu, slaves[inst.name], t0[inst.name] = build_c_fmu(inst, work)
+            else:
+                fmu, slaves[inst.name], t0[inst.name] = build_fmu(inst, work, runtime, shim)
             log(f"built {fmu.name}")
         conns = connections(system, slaves)
         starts.check(conns, slaves, t0)

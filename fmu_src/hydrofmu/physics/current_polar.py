@@ -220,3 +220,11 @@ class CurrentPolar:
 
     def mass_matrix(self, motion):
         return np.zeros((6, 6))
+
+    C_TAG = "polar"   # its record in a compiled FMU (current_polar.c)
+
+    def c_params(self):
+        """current_polar.c's parameters: [n, xc, yc, zc, surfc, the closed table's angles
+        (n + 2), coefficients ((n + 2)·3) and slopes ((n + 1)·3)]."""
+        return ([float(len(self.angles)), self.xc, self.yc, self.zc, self.surfc]
+                + self._a.tolist() + self._c.ravel().tolist() + self._slope.ravel().tolist())

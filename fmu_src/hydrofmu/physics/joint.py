@@ -167,6 +167,12 @@ class BallJoint:
         return (load_a, np.array((-fx, -fy, -fz, -tx - mx, -ty - my, -tz - mz)), np.array((dx, dy, dz)),
                 np.array(theta))
 
+    def c_params(self):
+        """joint.c's parameters: [point_a (3), point_b (3), k_lin, c_lin, k_rot, c_rot,
+        free (3, 0/1), r_rel0 (9, row-major)] (the node: its own ``c_params``)."""
+        return (self.point_a.tolist() + self.point_b.tolist() + [self.k_lin, self.c_lin, self.k_rot, self.c_rot]
+                + [float(f) for f in self.free.tolist()] + self.r_rel0.ravel().tolist())
+
     def mass_matrix(self, motion_a):
         """6×6 mass of the node about A's reference point (zeros without a node)."""
         return np.zeros((6, 6)) if self.node is None else self.node.mass_matrix(motion_a)

@@ -117,6 +117,13 @@ class LumpedBody:
         """6×6 mass M6 about the reference point, global axes; acceleration load −M6·[a; α]."""
         return point_mass_matrix(self.point_mass(motion), motion.rot @ self.offset)
 
+    C_TAG = "lumped"   # its record in a compiled FMU (lumped.c)
+
+    def c_params(self):
+        """lumped.c's parameters: [offset (3), am, ae, local (0/1), cd (3), added_mass (3)]."""
+        return (self.offset.tolist() + [self.am, self.ae, float(self.icoo == "LOCAL")] + self.cd.tolist()
+                + self.added_mass.tolist())
+
     def velocity_load(self, motion):
         """Centripetal part of the inertia load [N, N·m]: transfer(−M_p·ω×(ω×R r), R r), with
         M_p·c = AM·c + Q·diag(AMX, AMY, AMZ)·Qᵀ·c."""

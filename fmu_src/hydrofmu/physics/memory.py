@@ -201,6 +201,15 @@ class Convolution:
         m = sparse.csr_matrix((data, (rows, cols)), shape=(s.size, 2 * hl.shape[0]))
         return m @ self._h2
 
+    C_TAG = "convolution"   # its record in a compiled FMU (memory.c)
+
+    def c_params(self):
+        """memory.c's convolution parameters: [segments, elements, span, g (segments + 1),
+        hl and hr (segments × elements, row-major), output and input index per element]."""
+        nseg, ne = self._hl.shape
+        return ([float(nseg), float(ne), self.span] + self._g[:nseg + 1].tolist() + self._hl.ravel().tolist()
+                + self._hr.ravel().tolist() + self._out.astype(float).tolist() + self._in.astype(float).tolist())
+
     def state(self):
         """Everything needed to continue exactly: step lengths, velocity breakpoints (oldest
         first) and the current load, as plain lists."""
@@ -451,6 +460,14 @@ class StateSpace:
     @property
     def velocity(self):
         return self._x[self._nz:].copy()
+
+    C_TAG = "statespace"   # its record in a compiled FMU (memory.c)
+
+    def c_params(self):
+        """memory.c's state-space parameters: [modes m, μ (real parts, then imaginary), γ
+        (likewise), input and output index per mode]."""
+        return ([float(len(self._mu))] + self._mu.real.tolist() + self._mu.imag.tolist() + self._gam.real.tolist()
+                + self._gam.imag.tolist() + self._inp.astype(float).tolist() + self._out.astype(float).tolist())
 
     def restart(self, v0):
         """Set the velocity at the start (before any ``advance``; the states are still zero)."""

@@ -53,3 +53,9 @@ class ViscousDrag:
 
     def mass_matrix(self, motion):
         return np.zeros((6, 6))
+
+    C_TAG = "drag"   # its record in a compiled FMU (viscous_drag.c)
+
+    def c_params(self):
+        """viscous_drag.c's parameters: [relative, matrix (36, row-major)]."""
+        return [float(self.relative)] + self.matrix.ravel().tolist()

@@ -337,6 +337,10 @@ class WaveLoad:
         self.ramp = float(ramp_length)
         self._trig = np.empty(2 * w.size)
 
+    def c_params(self):
+        """waves.c's parameters: [N, ramp length, ω (N), table (2N × 7, row-major)]."""
+        return [float(self.omega.size), self.ramp] + self.omega.tolist() + self.table.ravel().tolist()
+
     def __call__(self, t):
         """(7,) [Fx, Fy, Fz, Mx, My, Mz, η] at time t."""
         n = self.omega.size

@@ -1,0 +1,149 @@
+"""The compiled flavour's figures (``hydrofmu bench --part floor``): per step and at startup
+in a native host, against the native floor.
+
+The native floor is a trivial compiled FMU (6 inputs, 6 outputs, fmi2DoStep copies the
+inputs to the outputs) built on the same FMI layer as every compiled hydrofmu FMU
+(fmi/fmu.c): what a compiled FMU cannot beat.  The host is ``native_host.c`` (this folder,
+bench/native.py), a C program that loads one FMU (dlopen), instantiates and initialises it,
+then steps it: every step sets all its inputs, calls fmi2DoStep and reads all its outputs.
+Startup is dlopen to the end of fmi2ExitInitializationMode in a fresh process (the FMU
+unzipped before, as every host does), the best of ``STARTUP_BEST``; the cost per step is
+the loop's time over its steps, also the best of ``STARTUP_BEST`` processes.  Candidate and floor alternate in ``rounds`` rounds; each multiple is
+the median of the rounds' ratios, too noisy above ``floor.NOISY``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from . import native
+from .floor import NOISY, STARTUP_BEST, spread
+
+
+def build_floor(folder) -> Path:
+    """The native floor FMU (``hydrofmu_cfloor.fmu``) in ``folder``."""
+    from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+    from ..fmi.cbuild import write_fmu
+
+    class Floor(Fmi2Slave):
+        author = "hydrofmu bench"
+        description = "trivial compiled FMU: fmi2DoStep copies u to y"
+        units, dependencies = {}, {}
+
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            for name, causality in (("u", Fmi2Causality.input), ("y", Fmi2Causality.output)):
+                for i in range(6):
+                    self.register_variable(Real(f"{name}[{i + 1}]", causality=causality, getter=lambda: 0.0,
+                                                **({"setter": lambda v: None} if name == "u" else {})))
+
+        def do_step(self, current_time, step_size):   # (the C floor's; this slave only describes it)
+            return True
+
+    slave = Floor(instance_name="floor")
+    slave._start = [0.0] * 12   # (the start values hydrofmu's slaves keep)
+    recs = [("kind", [3]), ("start", [0.0] * 12), ("copy", list(range(12)))]
+    return write_fmu(Path(folder) / "hydrofmu_cfloor.fmu", slave, recs)
+
+
+def compare(candidates, floor_fmu, out, rounds=5, steps=200_000, dt=0.05, best_of=STARTUP_BEST):
+    """{label: compiled FMU} against the native floor in the C timing host, rows {label,
+    step_us, step_floor_us, step_x, startup_ms, startup_floor_ms, startup_x, *_spread, *_noisy}."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    exe = native.host(out)
+    floor_args = native.unpack(floor_fmu, out / "floor")
+    unpacked = {label: native.unpack(f, out / f"c{k}") for k, (label, f) in enumerate(candidates.items())}
+
+    def measure(args):
+        """(startup [s], seconds per step), each the best of ``best_of`` fresh processes (noise
+        only adds time: a floor's loop of 200 000 steps lasts ~10 ms)."""
+        args = list(map(str, args[:3])) + [str(steps), repr(dt)] + list(args[3:])
+        got = [native._json([str(exe), *args]) for _ in range(best_of)]
+        return min(g["startup_s"] for g in got), min(g["step_s"] for g in got)
+
+    got = {label: [] for label in candidates}
+    for _ in range(rounds):
+        for label, args in unpacked.items():
+            (fs, fp), (cs, cp) = measure(floor_args), measure(args)
+            got[label].append([fs, cs, fp, cp])
+    rows = []
+    for label, t in got.items():
+        t = np.array(t)
+        start_x, step_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
+        rows.append({"label": label, "step_us": 1e6 * float(np.median(t[:, 3])),
+                     "step_floor_us": 1e6 * float(np.median(t[:, 2])), "step_x": float(np.median(step_x)),
+                     "startup_ms": 1e3 * float(np.median(t[:, 1])), "startup_floor_ms": 1e3 * float(np.median(t[:, 0])),
+                     "startup_x": float(np.median(start_x)),
+                     "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY,
+                     "startup_spread": spread(start_x), "startup_noisy": spread(start_x) > NOISY})
+    return rows
+
+
+def design_scene(folder) -> Path:
+    """models/side_by_side.toml with AQWA viscous drag on barge_a: its load FMU has
+    state-space memories (own and cross) and drag, the FMU the target speaks of."""
+    models = Path(__file__).resolve().parents[3] / "models"
+    text = (models / "side_by_side.toml").read_text().replace('deck = "decks/', f'deck = "{models.as_posix()}/decks/')
+    text += f"""
+[[bodies.barge_a.effects]]
+type = "aqwa_viscous_drag"
+deck = "{models.as_posix()}/decks/barge_viscous.aqwa"
+body = "BARGE"
+"""
+    path = Path(folder) / "side_by_side_drag.toml"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def part(out, quick, pythonfmu_floor):
+    """Lines of the compiled flavour's figures: the load FMU with state-space memory and drag,
+    the joint and dynamics FMUs against the native floor in the C host; the two-body design
+    scene in both flavours under our master (startup, per step, real-time factor) against
+    the pythonfmu floor."""
+    from ..fmi.build import build_scene
+    from ..scene import load_scene
+    from . import floor
+    quiet = lambda *_: None   # noqa: E731
+    out = Path(out) / "compiled"
+    cfloor = build_floor(out)
+    drag = build_scene(load_scene(design_scene(out)), out / "scenes", log=quiet, runtime="c")
+    joined = build_scene(load_scene(Path(__file__).resolve().parents[3] / "models" / "joined_barges.toml"),
+                         out / "scenes", log=quiet, runtime="c")
+    candidates = {"load FMU, state-space memory + drag": drag / "side_by_side_barge_a.fmu",
+                  "dynamics FMU, two coupled bodies": drag / "side_by_side_barge_a_barge_b_dynamics.fmu",
+                  "joint FMU (CONB)": joined / "joined_barges_hitch.fmu"}
+    rows = compare(candidates, cfloor, out / "unzipped", rounds=3 if quick else 5, steps=20_000 if quick else 200_000,
+                   best_of=1 if quick else STARTUP_BEST)
+    f = rows[0]
+    lines = [f"native floor (trivial compiled FMU, C host): {f['step_floor_us']:.2f} µs per step "
+             f"(set 6, doStep, get 6), startup {f['startup_floor_ms']:.2f} ms"]
+
+    def figure(r, what, text):
+        return (f"{what} too noisy (spread {100 * r[f'{what}_spread']:.0f} % > {100 * NOISY:.0f} %)"
+                if r[f"{what}_noisy"] else text)
+
+    for r in rows:
+        lines.append(f"compiled {r['label']}: " + figure(r, "step", f"{r['step_x']:.1f}× the native floor per step "
+                                                                   f"({r['step_us']:.2f} µs)")
+                     + "; " + figure(r, "startup", f"{r['startup_x']:.1f}× at startup ({r['startup_ms']:.2f} ms)"))
+    met = lambda x: "met" if x <= 3.0 else "NOT met"   # noqa: E731
+    for key, what in (("step", "per step"), ("startup", "at startup")):
+        if not f[f"{key}_noisy"]:
+            lines.append(f"target compiled load FMU ≤ 3× the native floor {what}: {met(f[f'{key}_x'])} "
+                         f"({f[f'{key}_x']:.1f}×)")
+    # the two-body design scene in both flavours, our master (fmpy), against the pythonfmu floor
+    scene = load_scene(Path(__file__).resolve().parents[3] / "models" / "side_by_side.toml")
+    both = {"side_by_side, Python flavour": build_scene(scene, out / "python", log=quiet, runtime="python"),
+            "side_by_side, compiled flavour": build_scene(scene, out / "c", log=quiet, runtime="c")}
+    step = scene.run["step"]
+    rows = floor.compare(both, pythonfmu_floor, out / "master", rounds=3 if quick else 5,
+                         steps=100 if quick else 2000, step=step, best_of=1 if quick else STARTUP_BEST)
+    for r in rows:
+        lines.append(f"{r['label']} (our master, fmpy): {r['step_us']:.0f} µs per step "
+                     f"({r['step_x']:.2f}× the pythonfmu floor), real-time factor {step / (1e-6 * r['step_us']):.0f}; "
+                     f"startup {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× the floor)"
+                     + (" [noisy]" if r["step_noisy"] or r["startup_noisy"] else ""))
+    return lines

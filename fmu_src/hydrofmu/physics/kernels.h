@@ -1,0 +1,117 @@
+/*
+ * The C load kernels of hydrofmu, one C file per physics module (viscous_drag.c beside
+ * viscous_drag.py, ...): the same formulas as the Python kernels, which stay the readable
+ * reference the tests hold these against.  Conventions are the Python modules' (global
+ * axes, z up, loads [F; M about the reference point], attitude (roll, pitch, yaw) with
+ * R = Rz(yaw) Ry(pitch) Rx(roll)).  No allocation, no FMI: fmi/fmu.c and fmi/models.c
+ * call these.
+ */
+#ifndef HYDROFMU_KERNELS_H
+#define HYDROFMU_KERNELS_H
+
+#include <stddef.h>
+
+/* physics/state.py: a body's motion (R computed from the attitude by hf_motion) */
+typedef struct {
+    const double *position, *attitude, *velocity, *acceleration;   /* 3, 3, 6, 6 (acceleration may be NULL) */
+    double R[9];   /* body-to-global rotation, row-major */
+} HfMotion;
+
+/* physics/current.py: a profile's shape, levels z increasing */
+typedef struct {
+    int n;
+    const double *z, *ratio, *turn;
+} HfProfile;
+
+/* physics/state.py Env: density, gravity, surface current, its profile (NULL: uniform);
+ * uniform: the current's components (hf_env sets them) */
+typedef struct {
+    double rho, g, speed, direction;
+    const HfProfile *profile;
+    double uniform[3];
+} HfEnv;
+
+/* kinematics.c */
+void hf_motion(HfMotion *m, const double *position, const double *attitude, const double *velocity,
+               const double *acceleration);
+void hf_rotation(const double *attitude, double *R);
+void hf_rotate(const double *R, const double *x, double *out);        /* R x */
+void hf_rotate_back(const double *R, const double *x, double *out);   /* R^T x */
+void hf_cross(const double *a, const double *b, double *out);
+void hf_point_mass_matrix(const double *mass3, const double *r, double *m6);
+void hf_current_components(double speed, double direction_deg, double *out);
+
+/* current.c */
+void hf_env(HfEnv *env, double rho, double g, double speed, double direction, const HfProfile *profile);
+void hf_current_at(const HfEnv *env, double z, double *out);
+
+/* viscous_drag.c: matrix 36 (body axes, row-major), relative 0/1 */
+void hf_viscous_drag(const double *matrix, int relative, const HfMotion *m, const HfEnv *env, double *out);
+
+/* current_polar.c: params [n, xc, yc, zc, surfc, angles (n+2), coef ((n+2)*3), slope ((n+1)*3)] */
+void hf_current_polar(const double *params, const HfMotion *m, const HfEnv *env, double *out);
+
+/* waves.c: params [n, ramp length, omega (n), table (2n x 7)]; out: [F (6), elevation] */
+void hf_waves(const double *params, double t, double *out);
+
+/* lumped.c: params [offset (3), am, ae, local (0/1), cd (3), added (3)] */
+int hf_lumped_uses_current(const double *params);
+int hf_lumped_uses_acceleration(const double *params);
+void hf_lumped_load(const double *params, const HfMotion *m, const HfEnv *env, double *out);
+void hf_lumped_mass_matrix(const double *params, const HfMotion *m, double *m6);
+void hf_lumped_velocity_load(const double *params, const HfMotion *m, double *out);
+
+/* joint.c: params [point_a (3), point_b (3), k_lin, c_lin, k_rot, c_rot, free (3), r_rel0 (9)];
+ * b NULL: the earth.  Loads on A and B, gap and rotation vector. */
+void hf_joint(const double *params, const HfMotion *a, const HfMotion *b, double *load_a, double *load_b,
+              double *gap, double *theta);
+
+/* memory.c: retardation memory of one 6x6 coupling side, F = -int h(s) v(t - s) ds.
+ * State space, params [m, mu_re (m), mu_im (m), gam_re (m), gam_im (m), inp (m), out (m)]:
+ * complex modes z' = mu z + v[inp], F[out] -= Re(gam z). */
+typedef struct {
+    int m;
+    const double *mu_re, *mu_im, *gam_re, *gam_im, *inp, *out;
+    double *z;                   /* 2m: (re, im) per mode */
+    double v[6], force[6];       /* velocity and load at the current time */
+    double dt, *coef;            /* the last step's coefficients: 6 per mode (e, b_old, b_new) */
+    double *pz, pv[6], pforce[6], pdt;   /* the last peek */
+    int peeked;
+} HfStateSpace;
+
+/* Convolution, params [nseg, nelem, span, g (nseg+1), hl (nseg*nelem), hr (nseg*nelem),
+ * out (nelem), in (nelem)]: piecewise-linear kernels (segment rows, element columns) and
+ * piecewise-linear velocity history, integrated exactly. */
+typedef struct {
+    int nseg, nelem;
+    double span;
+    const double *g, *hl, *hr, *out, *in;
+    double *v, *dt;              /* history nodes: v (6 each), dt from the node before */
+    int cap, lo, hi;
+    double force[6];
+    double *key, *w;             /* cached node offsets and their weights (nkey x nelem) */
+    int nkey, wcap;
+    double *s;                   /* scratch offsets */
+    double pforce[6], pv[6], pdt;
+    int plo, peeked;
+} HfConvolution;
+
+int hf_ss_init(HfStateSpace *ss, const double *params, int n);
+void hf_ss_free(HfStateSpace *ss);
+void hf_ss_restart(HfStateSpace *ss, const double *v);
+void hf_ss_peek(HfStateSpace *ss, double dt, const double *v, double *force);
+void hf_ss_advance(HfStateSpace *ss, double dt, const double *v);
+size_t hf_ss_state_size(const HfStateSpace *ss);
+void hf_ss_save(const HfStateSpace *ss, double *to);
+int hf_ss_load(HfStateSpace *ss, const double *from, size_t n);
+
+int hf_conv_init(HfConvolution *cv, const double *params, int n);
+void hf_conv_free(HfConvolution *cv);
+void hf_conv_restart(HfConvolution *cv, const double *v);
+int hf_conv_peek(HfConvolution *cv, double dt, const double *v, double *force);
+int hf_conv_advance(HfConvolution *cv, double dt, const double *v);
+size_t hf_conv_state_size(const HfConvolution *cv);
+void hf_conv_save(const HfConvolution *cv, double *to);
+int hf_conv_load(HfConvolution *cv, const double *from, size_t n);
+
+#endif

@@ -1,0 +1,313 @@
+/*
+ * Retardation memory of physics/memory.py in C: the two evaluators (StateSpace,
+ * Convolution) on one 6x6 coupling side, with the same formulas.  memory.py is the
+ * reference (and fits the realisations at build time); the build hands these functions
+ * the fitted modes and the kernel segments as memory.py holds them.
+ */
+#include <complex.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kernels.h"
+
+/* -- state space ------------------------------------------------------------------------ */
+
+/* phi1(x) = (e^x - 1)/x and phi2(x) = (e^x - 1 - x)/x^2 (memory._phi: Taylor below |x| 0.1) */
+static void phi(double complex x, double complex *p1, double complex *p2) {
+    if (cabs(x) < 0.1) {
+        double f[14];   /* f[n] = 1/(n+1)! */
+        double fact = 1.0;
+        for (int n = 0; n < 13; n++) fact *= n + 1, f[n] = 1.0 / fact;
+        double complex s1 = f[11], s2 = f[12];
+        for (int n = 10; n >= 0; n--) s1 = s1 * x + f[n], s2 = s2 * x + f[n + 1];
+        *p1 = s1, *p2 = s2;
+        return;
+    }
+    double a = sin(0.5 * cimag(x));   /* expm1 of a complex number, as numpy computes it */
+    double complex em = (expm1(creal(x)) * cos(cimag(x)) - 2.0 * a * a) + I * (exp(creal(x)) * sin(cimag(x)));
+    *p1 = em / x;
+    *p2 = (em - x) / (x * x);
+}
+
+int hf_ss_init(HfStateSpace *ss, const double *params, int n) {
+    memset(ss, 0, sizeof *ss);
+    if (n < 1) return -1;
+    int m = (int)params[0];
+    if (m < 0 || n != 1 + 6 * m) return -1;
+    ss->m = m;
+    ss->mu_re = params + 1, ss->mu_im = ss->mu_re + m, ss->gam_re = ss->mu_im + m, ss->gam_im = ss->gam_re + m;
+    ss->inp = ss->gam_im + m, ss->out = ss->inp + m;
+    ss->z = calloc(2 * (size_t)m + 1, sizeof(double));
+    ss->pz = calloc(2 * (size_t)m + 1, sizeof(double));
+    ss->coef = calloc(6 * (size_t)m + 1, sizeof(double));
+    ss->dt = -1.0;
+    return ss->z && ss->pz && ss->coef ? 0 : -1;
+}
+
+void hf_ss_free(HfStateSpace *ss) {
+    free(ss->z), free(ss->pz), free(ss->coef);
+    ss->z = ss->pz = ss->coef = NULL;
+}
+
+void hf_ss_restart(HfStateSpace *ss, const double *v) {
+    memcpy(ss->v, v, sizeof ss->v);
+    ss->peeked = 0;
+}
+
+/* The step's state into pz and load into pforce, nothing moved. */
+static void ss_step(HfStateSpace *ss, double dt, const double *v) {
+    int m = ss->m;
+    if (dt != ss->dt) {   /* coefficients of a new step length (a constant step: once) */
+        for (int k = 0; k < m; k++) {
+            double complex x = (ss->mu_re[k] + I * ss->mu_im[k]) * dt, p1, p2;
+            phi(x, &p1, &p2);
+            double complex e = cexp(x), bo = dt * (p1 - p2), bn = dt * p2;
+            double *c = ss->coef + 6 * k;
+            c[0] = creal(e), c[1] = cimag(e), c[2] = creal(bo), c[3] = cimag(bo), c[4] = creal(bn), c[5] = cimag(bn);
+        }
+        ss->dt = dt;
+    }
+    double f[6] = {0};
+    for (int k = 0; k < m; k++) {
+        const double *c = ss->coef + 6 * k;
+        int j = (int)ss->inp[k];
+        double zr = ss->z[2 * k], zi = ss->z[2 * k + 1], vo = ss->v[j], vn = v[j];
+        double nr = c[0] * zr - c[1] * zi + c[2] * vo + c[4] * vn;
+        double ni = c[1] * zr + c[0] * zi + c[3] * vo + c[5] * vn;
+        ss->pz[2 * k] = nr, ss->pz[2 * k + 1] = ni;
+        f[(int)ss->out[k]] += -ss->gam_re[k] * nr + ss->gam_im[k] * ni;
+    }
+    if (m) memcpy(ss->pforce, f, sizeof f);
+    else memcpy(ss->pforce, ss->force, sizeof f);
+    memcpy(ss->pv, v, sizeof ss->pv);
+    ss->pdt = dt;
+    ss->peeked = 1;
+}
+
+void hf_ss_peek(HfStateSpace *ss, double dt, const double *v, double *force) {
+    ss_step(ss, dt, v);
+    memcpy(force, ss->pforce, sizeof ss->pforce);
+}
+
+void hf_ss_advance(HfStateSpace *ss, double dt, const double *v) {
+    if (!ss->peeked || ss->pdt != dt || memcmp(ss->pv, v, sizeof ss->pv) != 0) ss_step(ss, dt, v);
+    double *t = ss->z;
+    ss->z = ss->pz, ss->pz = t;
+    memcpy(ss->v, ss->pv, sizeof ss->v);
+    memcpy(ss->force, ss->pforce, sizeof ss->force);
+    ss->peeked = 0;
+}
+
+size_t hf_ss_state_size(const HfStateSpace *ss) { return 2 * (size_t)ss->m + 12; }
+
+void hf_ss_save(const HfStateSpace *ss, double *to) {
+    memcpy(to, ss->z, sizeof(double) * 2 * ss->m);
+    memcpy(to + 2 * ss->m, ss->v, sizeof ss->v);
+    memcpy(to + 2 * ss->m + 6, ss->force, sizeof ss->force);
+}
+
+int hf_ss_load(HfStateSpace *ss, const double *from, size_t n) {
+    if (n != hf_ss_state_size(ss)) return -1;
+    memcpy(ss->z, from, sizeof(double) * 2 * ss->m);
+    memcpy(ss->v, from + 2 * ss->m, sizeof ss->v);
+    memcpy(ss->force, from + 2 * ss->m + 6, sizeof ss->force);
+    ss->peeked = 0;
+    return 0;
+}
+
+/* -- convolution ------------------------------------------------------------------------ */
+
+int hf_conv_init(HfConvolution *cv, const double *params, int n) {
+    memset(cv, 0, sizeof *cv);
+    if (n < 3) return -1;
+    int nseg = (int)params[0], ne = (int)params[1];
+    if (nseg < 0 || ne < 0 || n != 3 + (nseg + 1) + 2 * nseg * ne + 2 * ne) return -1;
+    cv->nseg = nseg, cv->nelem = ne, cv->span = params[2];
+    cv->g = params + 3, cv->hl = cv->g + nseg + 1, cv->hr = cv->hl + nseg * ne;
+    cv->out = cv->hr + nseg * ne, cv->in = cv->out + ne;
+    cv->cap = 64;
+    cv->v = calloc(6 * (size_t)cv->cap, sizeof(double));
+    cv->dt = calloc((size_t)cv->cap, sizeof(double));
+    cv->lo = 0, cv->hi = 1;
+    return cv->v && cv->dt ? 0 : -1;
+}
+
+void hf_conv_free(HfConvolution *cv) {
+    free(cv->v), free(cv->dt), free(cv->key), free(cv->w), free(cv->s);
+    cv->v = cv->dt = cv->key = cv->w = cv->s = NULL;
+}
+
+void hf_conv_restart(HfConvolution *cv, const double *v) {
+    memcpy(cv->v + 6 * (cv->hi - 1), v, sizeof(double) * 6);
+    cv->peeked = 0;
+}
+
+/* Room for one more node: grow when over half full, else compact (memory.Convolution._make_room). */
+static int make_room(HfConvolution *cv) {
+    int n = cv->hi - cv->lo;
+    if (2 * n > cv->cap) {
+        double *v = realloc(cv->v, sizeof(double) * 12 * cv->cap), *dt = realloc(cv->dt, sizeof(double) * 2 * cv->cap);
+        if (v) cv->v = v;
+        if (dt) cv->dt = dt;
+        if (!v || !dt) return -1;
+        memset(cv->v + 6 * cv->cap, 0, sizeof(double) * 6 * cv->cap);
+        memset(cv->dt + cv->cap, 0, sizeof(double) * cv->cap);
+        cv->cap *= 2;
+    } else {
+        memmove(cv->v, cv->v + 6 * cv->lo, sizeof(double) * 6 * n);
+        memmove(cv->dt, cv->dt + cv->lo, sizeof(double) * n);
+        cv->lo = 0, cv->hi = n;
+    }
+    return 0;
+}
+
+static int upper(const double *a, int n, double x) {   /* searchsorted(a, x, 'right') */
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (x < a[mid]) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* W[k, e] = int h_e(sigma) phi_k(sigma) dsigma, phi_k the hat function of node offset s_k
+ * (memory.Convolution._weights): on every piece between the merged breakpoints of s and g,
+ * h and the two hats are linear, so the integral is exact. */
+static void weights(HfConvolution *cv, const double *s, int ns, double *w) {
+    const double *g = cv->g;
+    int ng = cv->nseg + 1, ne = cv->nelem, nseg = cv->nseg;
+    memset(w, 0, sizeof(double) * ns * ne);
+    double top = fmin(s[ns - 1], g[ng - 1]);
+    int i = 0, j = 0, have = 0;
+    double prev_raw = 0.0, a = 0.0;   /* the last point of the union (before merging twins), the last kept */
+    while (i < ns || j < ng) {
+        double p;
+        if (j >= ng || (i < ns && s[i] < g[j])) p = s[i++];
+        else if (i >= ns || g[j] < s[i]) p = g[j++];
+        else p = s[i++], j++;   /* equal: one point */
+        if (have && p == prev_raw) continue;   /* (union1d: unique) */
+        if (p > top) break;
+        int keep = !have || p - prev_raw > 1e-12 * top;
+        prev_raw = p;
+        if (!keep) continue;
+        if (!have) {
+            a = p, have = 1;
+            continue;
+        }
+        double b = p, length = b - a, mid = 0.5 * (a + b);
+        int js = upper(g, ng, mid) - 1, k = upper(s, ns, mid) - 1;
+        if (js > nseg - 1) js = nseg - 1;
+        if (k > ns - 2) k = ns - 2;
+        double glen = g[js + 1] - g[js], aa = (a - g[js]) / glen, ab = (b - g[js]) / glen;
+        double slen = s[k + 1] - s[k], la = (a - s[k]) / slen, lb = (b - s[k]) / slen;
+        double c = length / 6.0;
+        double fa = c * (2 * la + lb), fb = c * (la + 2 * lb);
+        double na = c * (2 * (1 - la) + 1 - lb), nb = c * (1 - la + 2 * (1 - lb));
+        double kl = (1 - aa) * na + (1 - ab) * nb, kr = aa * na + ab * nb;
+        double fl = (1 - aa) * fa + (1 - ab) * fb, fr = aa * fa + ab * fb;
+        const double *hl = cv->hl + js * ne, *hr = cv->hr + js * ne;
+        double *wk = w + k * ne, *wf = w + (k + 1) * ne;
+        for (int e = 0; e < ne; e++) {
+            wk[e] += kl * hl[e] + kr * hr[e];
+            wf[e] += fl * hl[e] + fr * hr[e];
+        }
+        a = b;
+    }
+}
+
+/* F at node hi - 1 from the nodes lo ... hi - 1 into force; the first node still needed into *lo_out. */
+static int evaluate(HfConvolution *cv, int hi, double *force, int *lo_out) {
+    int lo = cv->lo, ns = hi - lo;
+    if (ns > cv->wcap) {
+        int cap = 2 * ns;
+        double *s = realloc(cv->s, sizeof(double) * cap), *key = realloc(cv->key, sizeof(double) * cap);
+        double *w = realloc(cv->w, sizeof(double) * cap * (cv->nelem ? cv->nelem : 1));
+        if (s) cv->s = s;
+        if (key) cv->key = key;
+        if (w) cv->w = w;
+        if (!s || !key || !w) return -1;
+        cv->wcap = cap;
+    }
+    double *s = cv->s;
+    s[0] = 0.0;
+    for (int k = 1; k < ns; k++) s[k] = s[k - 1] + cv->dt[hi - k];
+    int k = 0;   /* searchsorted(s, span, 'left') */
+    while (k < ns && s[k] < cv->span) k++;
+    if (k < ns - 1) {   /* nodes beyond the first past the span never matter again */
+        lo = hi - (k + 1);
+        ns = k + 1;
+    }
+    *lo_out = lo;
+    memset(force, 0, sizeof(double) * 6);
+    if (!cv->nelem || ns < 2 || cv->span == 0.0) return 0;
+    if (ns != cv->nkey || memcmp(s, cv->key, sizeof(double) * ns) != 0) {
+        weights(cv, s, ns, cv->w);
+        memcpy(cv->key, s, sizeof(double) * ns);
+        cv->nkey = ns;
+    }
+    for (int e = 0; e < cv->nelem; e++) {
+        double f = 0.0;
+        int in = (int)cv->in[e];
+        for (int q = 0; q < ns; q++) f += cv->w[q * cv->nelem + e] * cv->v[6 * (hi - 1 - q) + in];
+        force[(int)cv->out[e]] -= f;
+    }
+    return 0;
+}
+
+int hf_conv_peek(HfConvolution *cv, double dt, const double *v, double *force) {
+    if (cv->hi == cv->cap && make_room(cv)) return -1;
+    memcpy(cv->v + 6 * cv->hi, v, sizeof(double) * 6);
+    cv->dt[cv->hi] = dt;
+    if (evaluate(cv, cv->hi + 1, cv->pforce, &cv->plo)) return -1;
+    memcpy(cv->pv, v, sizeof cv->pv);
+    cv->pdt = dt;
+    cv->peeked = 1;
+    if (force) memcpy(force, cv->pforce, sizeof cv->pforce);
+    return 0;
+}
+
+int hf_conv_advance(HfConvolution *cv, double dt, const double *v) {
+    if (!cv->peeked || cv->pdt != dt || memcmp(cv->pv, v, sizeof cv->pv) != 0)
+        if (hf_conv_peek(cv, dt, v, NULL)) return -1;
+    memcpy(cv->force, cv->pforce, sizeof cv->force);
+    cv->lo = cv->plo;
+    cv->hi += 1;
+    cv->peeked = 0;
+    return 0;
+}
+
+/* [n nodes, dt (n - 1), v (6n), force (6)] */
+size_t hf_conv_state_size(const HfConvolution *cv) {
+    size_t n = (size_t)(cv->hi - cv->lo);
+    return 1 + (n - 1) + 6 * n + 6;
+}
+
+void hf_conv_save(const HfConvolution *cv, double *to) {
+    int n = cv->hi - cv->lo;
+    to[0] = n;
+    memcpy(to + 1, cv->dt + cv->lo + 1, sizeof(double) * (n - 1));
+    memcpy(to + n, cv->v + 6 * cv->lo, sizeof(double) * 6 * n);
+    memcpy(to + 7 * n, cv->force, sizeof cv->force);
+}
+
+int hf_conv_load(HfConvolution *cv, const double *from, size_t size) {
+    if (size < 1) return -1;
+    int n = (int)from[0];
+    if (n < 1 || size != (size_t)(7 * n + 6)) return -1;
+    int cap = 2 * n > 64 ? 2 * n : 64;
+    double *v = calloc(6 * (size_t)cap, sizeof(double)), *dt = calloc((size_t)cap, sizeof(double));
+    if (!v || !dt) {
+        free(v), free(dt);
+        return -1;
+    }
+    free(cv->v), free(cv->dt);
+    cv->v = v, cv->dt = dt, cv->cap = cap;
+    memcpy(dt + 1, from + 1, sizeof(double) * (n - 1));
+    memcpy(v, from + n, sizeof(double) * 6 * n);
+    memcpy(cv->force, from + 7 * n, sizeof cv->force);
+    cv->lo = 0, cv->hi = n;
+    cv->peeked = 0;
+    return 0;
+}
