@@ -349,14 +349,16 @@ def test_ten_thousand_instantiate_free_cycles_at_flat_memory(hosts, load_fmu):
 
 
 def test_dynamics_fmu_cycles_at_flat_memory(hosts, scenes, tmp_path):
-    """The same for a dynamics FMU (a state that integrates), 3000 cycles, flat after 500;
+    """The same for a dynamics FMU (a state that integrates), 3000 cycles, flat after 1000
+    (sampled every 250: under a loaded machine a few 16 kB allocator steps came after the
+    first 1000 cycles, which a median over five 500-cycle samples could not see past);
     the pooled instance, stepped with other forces in every cycle, restarts from rest."""
     dyn = unzip(scenes["moored_barge"] / "moored_barge_barge_dynamics.fmu", tmp_path)
     vr = dyn[3]
     inputs = {vr["force[1]"]: 1e3, vr["force[3]"]: -5e2, vr["force[5]"]: 2e3}
     outputs = [vr[f"position[{i}]"] for i in range(1, 4)] + [vr[f"attitude[{i}]"] for i in range(1, 4)]
-    rss, got, fresh = cycled(hosts, dyn, 3000, 500, inputs, outputs)
-    steady, total = growth([rss[k] for k in sorted(rss)])
+    rss, got, fresh = cycled(hosts, dyn, 3000, 250, inputs, outputs)
+    steady, total = growth([rss[k] for k in sorted(rss) if k >= 1000])
     assert steady < FLAT_KB and total < ARENA_KB, rss
     assert got == fresh and len(got) == 30 and got[0, 5, outputs[0]] != 0.0
 
