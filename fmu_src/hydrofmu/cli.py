@@ -402,8 +402,8 @@ def make_parser():
                                    "10 minutes in full.")
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
-                   choices=("overhead", "memory", "sweep", "growth", "floor", "native", "stability", "bem", "robust", "batch",
-                            "ecco", "longrun"),
+                   choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "bem",
+                            "robust", "batch", "ecco", "longrun"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="small sizes: a 1-minute smoke run, not the README figures")
     m = sub.add_parser("bem2simo", formatter_class=fmt,

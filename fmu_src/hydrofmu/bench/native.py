@@ -50,6 +50,21 @@ print(json.dumps({"startup_s": t1 - t0, "step_s": (t2 - t1) / max(steps, 1), "fr
 '''
 
 
+SCENE = '''import json, sys, time
+from hydrofmu.cosim import libcosim, master
+engine, folder, step, n1, n2 = sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
+run = libcosim.run if engine == "libcosim" else lambda *a, **k: master.run(*a, progress=False, **k)
+run(folder, stop=step, step=step, algorithm="jacobi")   # the process's first load: imports, unzipping
+t = []
+for n in (n1, n2):
+    t0 = time.perf_counter()
+    run(folder, stop=n * step, step=step, algorithm="jacobi")
+    t.append(time.perf_counter() - t0)
+per_step = (t[1] - t[0]) / (n2 - n1)
+print(json.dumps({"step_s": per_step, "startup_s": t[0] - n1 * per_step}))
+'''
+
+
 def host(folder) -> Path:
     """native_host.c compiled into ``folder``."""
     from ..cc import compiler
@@ -72,13 +87,26 @@ def unpack(fmu, folder):
     return str(Path(folder).resolve()), md.coSimulation.modelIdentifier, md.guid, ins, outs
 
 
+_exit_crashes = []   # children that printed their figures, then died at exit (counted, reported)
+
+
 def _json(cmd, env=None):
     out = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
-    if out.returncode != 0:
+    lines = out.stdout.strip().splitlines()
+    if out.returncode != 0 and not (lines and lines[-1].startswith("{")):
         raise RuntimeError(f"{cmd[0]} failed: {out.stdout[-2000:]}{out.stderr[-2000:]}")
-    got = json.loads(out.stdout.strip().splitlines()[-1])
+    got = json.loads(lines[-1])
     if got.get("failed"):
         raise RuntimeError(f"{cmd[0]}: an FMI call failed: {out.stderr[-2000:]}")
+    if out.returncode != 0:
+        _exit_crashes.append(f"{Path(cmd[0]).name} {Path(cmd[-7]).name} exit {out.returncode}: {out.stderr.strip()[-200:]}")
+    return got
+
+
+def exit_crashes():
+    """What the children that died after printing their figures said (and forget them)."""
+    got = list(_exit_crashes)
+    _exit_crashes.clear()
     return got
 
 
@@ -97,14 +125,32 @@ def compare(fmus, rounds=5, steps=10_000, dt=0.05, work=None):
                 py = _json([sys.executable, "-c", FMPY, *args])
                 c = _json([str(exe), *args])
                 got[label].append([py["step_s"], c["step_s"], py["startup_s"], c["startup_s"]])
-    rows = []
-    for label, t in got.items():
-        t = np.array(t)
-        step_x, start_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
-        rows.append({"label": label, "step_us": 1e6 * float(np.median(t[:, 1])),
-                     "step_fmpy_us": 1e6 * float(np.median(t[:, 0])), "step_x": float(np.median(step_x)),
-                     "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY,
-                     "startup_s": float(np.median(t[:, 3])), "startup_fmpy_s": float(np.median(t[:, 2])),
-                     "startup_x": float(np.median(start_x)), "startup_spread": spread(start_x),
-                     "startup_noisy": spread(start_x) > NOISY})
-    return rows
+    return [_row(label, t) for label, t in got.items()]
+
+
+def _row(label, t):
+    """The row of one candidate from its rounds [fmpy step, native step, fmpy startup, native startup]."""
+    t = np.array(t)
+    step_x, start_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
+    return {"label": label, "step_us": 1e6 * float(np.median(t[:, 1])),
+            "step_fmpy_us": 1e6 * float(np.median(t[:, 0])), "step_x": float(np.median(step_x)),
+            "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY or np.median(t[:, 1]) <= 0,
+            "startup_s": float(np.median(t[:, 3])), "startup_fmpy_s": float(np.median(t[:, 2])),
+            "startup_x": float(np.median(start_x)), "startup_spread": spread(start_x),
+            "startup_noisy": spread(start_x) > NOISY}
+
+
+def compare_scene(folder, rounds=5, steps=2000):
+    """A built scene (its folder) run with Jacobi exchanges by libcosim (libcosimpy: the FMUs
+    are called from libcosim's C++ worker threads, which Python does not know) and by our fmpy
+    master, every output recorded by both, in rounds of fresh processes.  The cost per step is
+    the marginal cost between runs of 10 and ``steps`` steps, the startup what is left of the
+    short run (a run after the process's first).  Row {label, step_us, step_fmpy_us, step_x,
+    step_spread, step_noisy, startup_s, startup_fmpy_s, startup_x, startup_spread, startup_noisy}."""
+    step = json.loads((Path(folder) / "manifest.json").read_text())["run"]["step"]
+    t = []
+    for _ in range(rounds):
+        got = [_json([sys.executable, "-c", SCENE, engine, str(folder), repr(step), "10", str(steps)])
+               for engine in ("fmpy", "libcosim")]
+        t.append([got[0]["step_s"], got[1]["step_s"], got[0]["startup_s"], got[1]["startup_s"]])
+    return _row(f"{Path(folder).name} in libcosim", t)

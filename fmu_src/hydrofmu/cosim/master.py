@@ -14,13 +14,12 @@ Initialisation resolves the feedthrough: connections are transferred twice insid
 initialization mode, so at t = 0 every load output reflects the initial motion.
 """
 import ctypes
-import shutil
 import sys
 import time as clock
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, read_model_description
+from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
@@ -30,6 +29,7 @@ from ..errors import InputError
 from ..names import unknown
 from .manifest import read_manifest
 from .result import Result
+from .unpacked import unpacked
 
 
 class RunError(RuntimeError):
@@ -74,14 +74,25 @@ def describe(settings):
             + (f"; memory {memory}" if memory else ""))
 
 
+_descriptions = {}   # unzipped FMU folder (named by its content) -> its model description
+
+
+def _model_description(folder):
+    """fmpy's reading of an unzipped FMU's modelDescription.xml, once per process (the
+    folder's content never changes: ``cosim.unpacked``)."""
+    if folder not in _descriptions:
+        _descriptions[folder] = read_model_description(folder)
+    return _descriptions[folder]
+
+
 class Instance:
     """One FMU instance with its value references by name."""
 
     def __init__(self, name, fmu_path):
         self.name = name
         self.errors = []   # error/fatal messages the FMU logged (they go into RunError)
-        self.md = read_model_description(str(fmu_path))
-        self.dir = extract(str(fmu_path))
+        self.dir = str(unpacked(fmu_path))   # unzipped once, shared with later runs (cosim.unpacked)
+        self.md = _model_description(self.dir)
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.causality = {v.name: v.causality for v in self.md.modelVariables}
         self.units = {v.name: v.unit for v in self.md.modelVariables if v.unit}
@@ -147,7 +158,6 @@ class Instance:
             pass   # a failed instance may refuse to terminate; it is freed all the same
         finally:
             self.fmu.freeInstance()
-            shutil.rmtree(self.dir, ignore_errors=True)  # the extracted copy (batches run thousands)
 
 
 class Port:

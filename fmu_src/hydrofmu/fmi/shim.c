@@ -525,6 +525,24 @@ static void keep_thread_state(void) {
     if (ts_key_ok) pthread_setspecific(ts_key, state); /* else kept until the process ends */
 }
 
+/*
+ * pythonfmu 0.7 keeps its interpreter guard in a global shared_ptr that two things release
+ * at exit: the C++ static destructor (run among the atexit handlers) and its exported
+ * destructor function finalizePythonInterpreter (run after them, by the loader), which then
+ * decrements the count in the freed block: whether a host dies at exit ("free(): corrupted
+ * unsorted chunks") depends on what the heap holds there (a longer folder name made it
+ * 8 runs in 10).  Its library is never unloaded (C++ unique symbols), so every process that
+ * instantiated one exits through this.  The shim releases the guard itself first, from an
+ * atexit handler registered after pythonfmu's static constructors (so it runs before their
+ * destructors, or when the host unloads the shim): both later releases then find it empty.
+ */
+static void (*inner_release_guard)(void);
+
+static void release_guard(void) {
+    if (inner_release_guard) inner_release_guard();
+    inner_release_guard = NULL;
+}
+
 static void load_inner(void) {
     char path[4096];
     if (!inner_path(path, sizeof path)) return;
@@ -562,6 +580,8 @@ static void load_inner(void) {
 #undef RESOLVE
     inner_handle = h;
     inner_ok = 1;
+    *(void **)&inner_release_guard = dlsym(h, "finalizePythonInterpreter"); /* pythonfmu 0.7; optional */
+    if (inner_release_guard) atexit(release_guard);
 }
 
 static int ready(void) {
