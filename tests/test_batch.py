@@ -194,3 +194,54 @@ def test_case_file_errors(tmp_path):
     with pytest.raises(InputError, match="barge.no_such_parameter"):
         hydrofmu.run_batch(path, tmp_path / "out", progress=False)
     assert not (tmp_path / "out" / "cases").exists()
+
+
+def test_sea_state_knobs_share_one_build(client, tmp_path):
+    """hs, tp and seed (aliases of waves.hs, waves.tp, waves.seed) are FMU parameters: the
+    cases share one build, each case's statistics are those of the in-process run with the
+    same parameters, and `significant` is 4·std (for the elevation: the record's Hs)."""
+    import shutil
+    from hydrofmu.cosim import inprocess
+    from hydrofmu.cosim.master import run
+    data = ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc"
+    shutil.copy(data, tmp_path / data.name)
+    scene = tmp_path / "sea.toml"
+    scene.write_text(f"""
+[run]
+step = 0.1
+stop = 60.0
+[waves]
+spectrum = "jonswap"
+hs = 1.0
+tp = 6.0
+ramp = 5.0
+components = 50
+[bodies.cyl]
+mass = 51191.7
+inertia = [204766.8, 204766.8, 115181.3]
+cog = [0.0, 0.0, -3.0]
+stiffness = [1e4, 1e4, 0.0, 0.0, 0.0, 1e5]      # mooring; the restoring in heave, roll, pitch: the dataset's
+damping = [2e4, 2e4, 4e4, 3e5, 3e5, 1e5]
+[[bodies.cyl.effects]]
+type = "wave_excitation"
+bem = "{data.name}"
+[[bodies.cyl.effects]]
+type = "bem_hydrostatics"
+bem = "{data.name}"
+""")
+    outputs = ["cyl.waves.elevation", "cyl_dynamics.position[3]"]
+    cases = tmp_path / "cases.toml"
+    cases.write_text(f'scene = "{scene}"\noutputs = {json.dumps(outputs)}\ntransient = 10.0\n'
+                     '[matrix]\nhs = [0.5, 1.0]\ntp = [5.0, 8.0]\nseed = [3]\n')
+    table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
+    assert len(table) == 4 and (table["status"] == "ok").all(), table[["status", "error"]]
+    assert table["build"].nunique() == 1
+    for _, row in table.iterrows():
+        params = {"cyl.waves.hs": row["waves.hs"], "cyl.waves.tp": row["waves.tp"], "cyl.waves.seed": row["waves.seed"]}
+        ref = run(inprocess.system(load_scene(scene), params), progress=False, record=outputs)
+        after = ref.time >= 10.0
+        for name in outputs:
+            x = ref[name][after]
+            assert row[f"{name}.std"] == pytest.approx(x.std(), rel=1e-9)
+            assert row[f"{name}.significant"] == pytest.approx(4 * x.std(), rel=1e-9)
+        assert row["cyl.waves.elevation.significant"] == pytest.approx(row["waves.hs"], rel=0.25)   # 50 s of record

@@ -52,9 +52,32 @@ class System:
     indicators: dict[str, float]
 
 
+TIMED = ("wave_excitation",)   # effects that depend on time, not motion: the load FMU drives them itself
+
+
 def body_loads(body):
-    """physics.loads.BodyLoads of a scene body."""
-    return BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects], body.accel_mode == "explicit")
+    """physics.loads.BodyLoads of a scene body (its motion-dependent effects)."""
+    return BodyLoads([make_effect(e.type, e.name, e.data) for e in body.effects if e.type not in TIMED],
+                     body.accel_mode == "explicit")
+
+
+def wave_window(scene):
+    """The frequency window [rad/s] every body's excitation covers: one set of components for
+    the whole scene (one wave field)."""
+    omegas = [e.data["omega"] for b in scene.bodies.values() for e in b.effects if e.type == "wave_excitation"]
+    return [max(w[0] for w in omegas), min(w[-1] for w in omegas)] if omegas else None
+
+
+def body_waves(scene, body):
+    """description.Waves of a body, or None (no [waves] in the scene, or no excitation)."""
+    eff = next((e for e in body.effects if e.type == "wave_excitation"), None)
+    if scene.waves is None or eff is None:
+        return None
+    sea = {k: v for k, v in vars(scene.waves).items() if k != "spectrum"}
+    dat = eff.data
+    return d.Waves(eff.name, scene.waves.spectrum, sea, wave_window(scene), np.array(dat["omega"]),
+                   np.array(dat["directions"]), np.array(dat["re"]), np.array(dat["im"]),
+                   np.array(body.position[:2], float))
 
 
 def initial_motion(body):
@@ -195,13 +218,15 @@ def _loads(scene, body, sides, env):
             for s in sides if target(s) == body.name]
     motion = {"": body.name}
     motion.update({f"{s.source}.": s.source for s in mine if not s.own})
-    names = [f"{e.name} ({e.type})" for e in body.effects] + [f"{s.name} (simo_coupling)" for s in mine]
+    waves = body_waves(scene, body)
+    names = [f"{e.name} ({e.type})" for e in body.effects if e.type not in TIMED or waves is not None]
+    names += [f"{s.name} (simo_coupling)" for s in mine]
     fmu = d.LoadFMU(
         description=f"hydrodynamic loads on '{body.name}' (scene {scene.name}): "
                     + (", ".join(names) or "no effects"),
         body=body.name, position=np.array(body.position, float), attitude=np.array(body.attitude, float),
-        accel_mode=body.accel_mode, effects=list(body.effects), couplings=mine, environment=env,
-        velocity=np.array(body.velocity, float))
+        accel_mode=body.accel_mode, effects=[e for e in body.effects if e.type not in TIMED], couplings=mine,
+        environment=env, velocity=np.array(body.velocity, float), waves=waves)
     return Instance(body.name, f"{scene.name}_{body.name}", "load", body.name, fmu, motion,
                     [("force", body.name, d.DynamicsBody.load_input(""))])
 

@@ -47,13 +47,18 @@ from .cosim.manifest import read_manifest
 from .textfile import read_toml
 from .writable import check_folder
 
-RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorithm"}
+RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorithm",
+               "hs": "waves.hs", "tp": "waves.tp", "seed": "waves.seed", "wave_direction": "waves.direction"}
 # scene keys the FMUs expose: key -> FMU variable name (in every FMU that has it)
 EXPOSED = {"environment.current_speed": "current.speed", "environment.current_direction": "current.direction",
-           "environment.rho": "rho", "environment.g": "g"}
-STATS = ("max", "min", "mean", "std", "final")
+           "environment.rho": "rho", "environment.g": "g",
+           **{f"waves.{k}": f"waves.{k}" for k in ("hs", "tp", "gamma", "direction", "spreading", "components",
+                                                   "seed", "ramp", "height", "period", "phase")}}
+# statistics of each output; significant = 4·std (the significant value of a narrow-band
+# response, as Hs = 4·sqrt(m0) of the elevation)
+STATS = ("max", "min", "mean", "std", "significant", "final")
 FILE_KEYS = file_keys.names(file_keys.CASES)
-SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings")
+SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "waves")
 
 
 @dataclass
@@ -447,7 +452,7 @@ def statistics(time_, values, outputs, transient=0.0):
     out = {}
     for j, name in enumerate(outputs):
         col = keep[:, j]
-        for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), col[-1])):
+        for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), 4 * col.std(), col[-1])):
             out[f"{name}.{stat}"] = float(value)
     return out
 

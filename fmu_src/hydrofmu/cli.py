@@ -403,7 +403,7 @@ def make_parser():
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "bem",
-                            "robust", "batch", "ecco", "longrun"),
+                            "robust", "batch", "ecco", "longrun", "waves"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="small sizes: a 1-minute smoke run, not the README figures")
     m = sub.add_parser("bem2simo", formatter_class=fmt,

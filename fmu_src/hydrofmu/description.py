@@ -129,6 +129,34 @@ class CouplingSide:
 
 
 @dataclass
+class Waves:
+    """The scene's wave field as one body's FMU sees it (physics.waves): the sea state
+    ``spectrum`` and its knobs ``sea`` (SeaState fields: start values of the ``waves.*``
+    parameters), the frequency ``window`` [rad/s] common to every body of the scene (so
+    that all draw the same components), and this body's excitation transfer function per
+    unit amplitude: ``omega`` [rad/s], ``directions`` [deg], ``re`` + i·``im`` (nω, nβ, 6)
+    [N/m, N·m/m], e^{+iωt}, referred to the global origin; ``position`` (x, y) [m] its mean
+    position; effect ``name`` (outputs ``<name>.force``, ``<name>.elevation``)."""
+    name: str
+    spectrum: str
+    sea: dict
+    window: list[float]
+    omega: np.ndarray
+    directions: np.ndarray
+    re: np.ndarray
+    im: np.ndarray
+    position: np.ndarray
+
+    def sea_state(self, **knobs):
+        from .physics.waves import SeaState
+        return SeaState(self.spectrum, **{**self.sea, **knobs})
+
+    def transfer(self, g, depth):
+        from .physics.waves import TransferFunction
+        return TransferFunction(self.omega, self.directions, self.re + 1j * self.im, self.position, g, depth)
+
+
+@dataclass
 class LoadFMU:
     """Hydrodynamic loads on one body: its effects and coupling sides.  ``position``,
     ``attitude``, ``velocity``: the reference point's state at t = 0 (the motion inputs'
@@ -143,6 +171,7 @@ class LoadFMU:
     couplings: list[CouplingSide]
     environment: Environment
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    waves: Waves | None = None
 
 
 @dataclass

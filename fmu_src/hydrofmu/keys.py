@@ -123,6 +123,33 @@ EFFECTS = {
     },
 }
 
+BEM_EFFECT = {
+    "bem": (STRING, "Capytaine dataset (.nc), or WAMIT file, relative to the scene"),
+    "body": (STRING, "BEM body (optional for a one-body file; WAMIT: body1, body2, …)"),
+    "ulen": (POSITIVE, "WAMIT: the length ULEN [m]"),
+}
+# effects whose data always come from a BEM result: no deck variant (an empty one never matches)
+EFFECTS["wave_excitation"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "excitation: Capytaine dataset "
+                                                                                  "(.nc) or WAMIT .3 / .2")}}
+EFFECTS["bem_hydrostatics"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "hydrostatics: Capytaine dataset "
+                                                                                   "(.nc) or WAMIT .hst")}}
+
+WAVES = {
+    "spectrum": (enum("regular", "jonswap", "pierson_moskowitz"), "sea state type (default jonswap)"),
+    "hs": (NONNEG, "significant wave height Hs = 4·sqrt(m0) [m] (spectra)"),
+    "tp": (POSITIVE, "spectral peak period [s] (spectra)"),
+    "gamma": ({"type": "number", "minimum": 1}, "JONSWAP peak enhancement (default 3.3)"),
+    "height": (NONNEG, "regular wave height H [m]"),
+    "period": (POSITIVE, "regular wave period [s]"),
+    "phase": (NUMBER, "regular wave phase at the origin, t = 0 [deg]"),
+    "direction": (NUMBER, "wave direction [deg], going to, counter-clockwise from +x"),
+    "spreading": (NONNEG, "cos-2s spreading exponent s (0: long-crested)"),
+    "components": ({"type": "integer", "minimum": 1}, "number of wave components (default 200)"),
+    "seed": ({"type": "integer", "minimum": 0}, "random seed of frequencies, phases, directions"),
+    "ramp": (NONNEG, "length of the smooth start ramp [s]"),
+    "depth": (POSITIVE, "water depth [m] (default: deep water)"),
+}
+
 BODY = {
     "position": (vector(3), "initial (equilibrium) position of the reference point [m], global"),
     "attitude": (vector(3), "initial roll, pitch, yaw [rad]"),
@@ -193,6 +220,7 @@ SCENE = {
     "couplings": ({"couplings": (COUPLING, BEM_COUPLING)},
                   "SIMO hydrodynamic couplings ([[couplings]]: deck + coupling, or bem)"),
     "build": ({"table": BUILD}, "build settings (hydrofmu build)"),
+    "waves": ({"table": WAVES}, "one wave field for the scene: the sea state ([waves])"),
 }
 
 CASES = {

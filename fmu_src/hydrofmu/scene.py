@@ -6,6 +6,7 @@ and raises one InputError listing them all before anything is built.  Effect dat
 comes inline or from a vendor deck (path relative to the scene file + the name of the
 body/structure in the deck).  The format, key by key: docs/scenes.md.
 """
+import math
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,6 +58,7 @@ class Scene:
     warnings: list = field(default_factory=list)   # suspicious but legal input, said at load (InputWarning)
     decks: list = field(default_factory=list)   # decks.lines.Reading of each deck read: used, skipped, warnings
     runtime: str = "python"          # [build] runtime: "python" (pythonfmu) or "c" (compiled)
+    waves: object = None             # physics.waves.SeaState of [waves], or None (no waves)
 
 
 class Problems:
@@ -353,8 +355,61 @@ def _riflex_body(problems, table, where):
     return {**data, "offset": offset}
 
 
+def _bem_entry(problems, table, where, reader):
+    """(data read by ``reader``, file, BEM body name) of a BEM wave effect entry (keys bem,
+    body, ulen), or (None, None, None) after recording the problem."""
+    path = _deck_path(problems, table, where, "bem")
+    ulen = problems.number(table, "ulen", f"{where}.ulen", positive=True) if "ulen" in table else None
+    body = problems.string(table, "body", f"{where}.body") if "body" in table else None
+    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None):
+        return None, None, None
+    env = getattr(problems, "env", {})
+    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81))
+    if data is None:
+        return None, None, None
+    if body is None:
+        if len(data.bodies) != 1:
+            problems.add(f"{where}.body", f"{path.name} holds {len(data.bodies)} bodies ({', '.join(data.bodies)}): "
+                                          "name one")
+            return None, None, None
+        body = data.bodies[0]
+    if body not in data.bodies:
+        problems.add(f"{where}.body", f"{body!r} is not a body of {path.name} (it has: {', '.join(data.bodies)})")
+        return None, None, None
+    return data, path, body
+
+
+def _wave_excitation(problems, table, where):
+    """First-order wave excitation from a BEM result (Capytaine .nc, WAMIT .3 / .2): the
+    transfer functions of one BEM body; the sea state is the scene's [waves]."""
+    from .decks.bem_waves import read_excitation
+    problems.known_keys(table, where, {"type", "name", "bem", "body", "ulen"})
+    data, path, body = _bem_entry(problems, table, where, read_excitation)
+    if data is None:
+        return None
+    x = data.body(body)
+    return {"bem": str(path), "body": body, "kind": data.kind, "omega": data.omega.tolist(),
+            "directions": data.directions.tolist(), "re": x.real.tolist(), "im": x.imag.tolist(),
+            "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g,
+            "water_depth": data.water_depth}
+
+
+def _bem_hydrostatics(problems, table, where):
+    """Hydrostatic restoring −C·(η − η0) from a BEM result (Capytaine .nc, WAMIT .hst)."""
+    from .decks.bem_waves import read_hydrostatics
+    problems.known_keys(table, where, {"type", "name", "bem", "body", "ulen"})
+    data, path, body = _bem_entry(problems, table, where, read_hydrostatics)
+    if data is None:
+        return None
+    return {"bem": str(path), "body": body, "kind": data.kind, "stiffness": data.stiffness[body].tolist(),
+            "weight": data.weight, "mass": data.mass.get(body), "center_of_mass": data.center_of_mass.get(body),
+            "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g}
+
+
 # type -> (validator, default effect name)
 EFFECT_TYPES = {
+    "wave_excitation": (_wave_excitation, "waves"),
+    "bem_hydrostatics": (_bem_hydrostatics, "hydrostatics"),
     "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
     "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),
     "riflex_body": (_riflex_body, "riflex_body"),
@@ -758,6 +813,10 @@ def _load_scene(path, overrides=None):
             p.add(f"run.{field_}", message)
     if "ecco" in run and run_cfg["algorithm"] not in (None, "ecco"):
         p.add("run.ecco", f"ECCO settings need algorithm = \"ecco\" (the run's algorithm is {run_cfg['algorithm']!r})")
+    # rho and g first: the BEM wave effects of the bodies make WAMIT files dimensional with them
+    rho = p.number(env, "rho", "environment.rho", 1025.0, positive=True)
+    g = p.number(env, "g", "environment.g", 9.81, positive=True)
+    p.env = {"rho": rho or 1025.0, "g": g or 9.81}
     bodies_t = p.table(doc, "bodies", "bodies") or {}
     bodies = {}
     for bname, btable in bodies_t.items():
@@ -776,22 +835,145 @@ def _load_scene(path, overrides=None):
         joint = _joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
-    rho = p.number(env, "rho", "environment.rho", 1025.0, positive=True)
-    g = p.number(env, "g", "environment.g", 9.81, positive=True)
     couplings = (_couplings(p, doc["couplings"], bodies, run_cfg["memory"], {"rho": rho, "g": g})
                  if "couplings" in doc else [])
     speed, direction, profile = _current(p, env)
+    sea = _waves(p, doc["waves"]) if "waves" in doc else None
+    _wave_effects(p, bodies, sea, rho, g)
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
-        bodies=bodies, run=run_cfg, decks=p.readings, runtime=runtime or "python",
+        bodies=bodies, run=run_cfg, decks=p.readings, runtime=runtime or "python", waves=sea,
     )
     p.raise_if_any()
     return scene
 
 
-SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build")
+SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")
 RUNTIMES = tuple(keys.BUILD["runtime"][0]["enum"])   # [build] runtime: fmi/build.py, fmi/cbuild.py
+WAVE_KEYS = keys.names(keys.WAVES)
+
+
+def _waves(problems, table):
+    """The sea state of ``[waves]`` (physics.waves.SeaState), checked; None after recording
+    the problems."""
+    from .physics.waves import SPECTRA, SeaState, WaveError
+    if not isinstance(table, dict):
+        problems.add("waves", "expected a table [waves]")
+        return None
+    problems.known_keys(table, "waves", WAVE_KEYS)
+    spectrum = problems.choice(table, "spectrum", "waves.spectrum", SPECTRA, "jonswap")
+    if spectrum is None:
+        return None
+    need = ("height", "period") if spectrum == "regular" else ("hs", "tp")
+    defaults = SeaState()
+    values = {}
+    for key in WAVE_KEYS - {"spectrum", "depth"}:
+        if key in table or key not in need:
+            values[key] = problems.number(table, key, f"waves.{key}", getattr(defaults, key))
+        else:
+            problems.add(f"waves.{key}", f"missing value ({spectrum} waves need {' and '.join(need)})")
+            values[key] = None
+    depth = table.get("depth", math.inf)
+    if isinstance(depth, float) and depth == math.inf:      # TOML's inf: deep water (the default)
+        values["depth"] = math.inf
+    else:
+        values["depth"] = problems.number(table, "depth", "waves.depth", positive=True)
+    if None in values.values():
+        return None
+    for key in ("components", "seed"):
+        values[key] = int(values[key]) if values[key] == int(values[key]) else values[key]
+    sea = SeaState(spectrum, **values)
+    try:
+        sea.check()
+    except WaveError as exc:
+        problems.add(f"waves.{exc.field}", str(exc))
+        return None
+    return sea
+
+
+def _wave_effects(problems, bodies, sea, rho, g):
+    """Checks of the BEM wave effects against the scene: rho, g, depth, rotation centres at the
+    reference points (positions matter to the excitation's phase: no shift allowed), the sea
+    state within every transfer function (frequencies, directions), the hydrostatics' mass,
+    centre of mass and weight terms against the body's, and no restoring counted twice.
+    Fills each hydrostatics effect's equilibrium pose."""
+    from .physics.kinematics import rotation
+    from .physics.waves import TransferFunction, WaveError, components
+    tfs = []
+    for body in bodies.values():
+        for i, eff in enumerate(body.effects):
+            if eff.type not in ("wave_excitation", "bem_hydrostatics") or body.position is None:
+                continue
+            where, d = f"bodies.{body.name}.effects[{i}]", eff.data
+            name = Path(d["bem"]).name
+            bad = [f"{k} = {d[k]:g} in {name} but {v:g} in the scene (environment.{k})"
+                   for k, v in (("rho", rho), ("g", g)) if d.get(k) is not None and v is not None
+                   and abs(d[k] - v) > 1e-6 * v]
+            centre = d.get("rotation_center")
+            if centre is not None and np.max(np.abs(np.subtract(centre, body.position))) > CENTRE_TOL:
+                bad.append(f"rotation_center of {d['body']!r} in {name} is {centre} m but the reference point of body "
+                           f"{body.name!r} is at {body.position} m: the transfer functions are about the rotation centre "
+                           f"and their phases refer to the body's place (move the body or solve again)")
+            if eff.type == "wave_excitation":
+                depth = d.get("water_depth")
+                if sea is not None and depth is not None and not (depth == sea.depth or
+                                                                  abs(depth - sea.depth) <= 1e-6 * sea.depth):
+                    bad.append(f"water_depth = {depth:g} m in {name} but waves.depth = {sea.depth:g} m")
+                elif not bad:
+                    values = np.asarray(d["re"]) + 1j * np.asarray(d["im"])
+                    try:
+                        tfs.append((where, name, TransferFunction(d["omega"], d["directions"], values,
+                                                                  body.position[:2], g or 9.81,
+                                                                  sea.depth if sea else math.inf)))
+                    except WaveError as exc:
+                        bad.append(f"{name}: {exc}")
+            else:
+                bad += _hydrostatic_problems(d, body, name, rotation)
+                d["position0"], d["attitude0"] = list(body.position or [0.0] * 3), list(body.attitude or [0.0] * 3)
+            for message in bad:
+                problems.add(f"{where}.bem", message)
+    if sea is None or not tfs:
+        return
+    lo = max(tf.window[0] for _, _, tf in tfs)
+    hi = min(tf.window[1] for _, _, tf in tfs)
+    try:
+        comps = components(sea, (lo, hi))
+    except WaveError as exc:
+        problems.add(f"waves.{exc.field}", f"{exc} (from {', '.join(sorted({n for _, n, _ in tfs}))})")
+        return
+    for where, name, tf in tfs:
+        try:
+            tf.at(comps.omega, comps.direction)
+        except WaveError as exc:
+            problems.add(f"waves.{exc.field}", f"{name} ({where}): {exc}")
+            return
+
+
+MASS_TOL = 0.01   # relative: the BEM result's mass against the scene's
+
+
+def _hydrostatic_problems(d, body, name, rotation):
+    """What makes a BEM hydrostatic matrix wrong for this scene body (messages)."""
+    bad = []
+    if not d["weight"]:
+        bad.append(f"{name} gives no centre of mass: cannot tell whether its hydrostatic_stiffness holds the "
+                   "weight's moment (solve with center_of_mass set)")
+    if d.get("mass") is not None and body.mass is not None and abs(d["mass"] - body.mass) > MASS_TOL * body.mass:
+        bad.append(f"mass = {d['mass']:.6g} kg in {name} (its restoring's weight terms) but {body.mass:.6g} kg in the "
+                   f"scene (bodies.{body.name}.mass)")
+    com = d.get("center_of_mass")
+    if com is not None and None not in (body.position, body.attitude, body.cog):
+        scene_com = np.add(body.position, rotation(body.attitude) @ np.asarray(body.cog, float))
+        if np.max(np.abs(scene_com - com)) > CENTRE_TOL:
+            bad.append(f"center_of_mass = {com} m in {name} but {scene_com.round(6).tolist()} m in the scene "
+                       f"(bodies.{body.name}.position + cog)")
+    k = np.asarray(body.stiffness if body.stiffness is not None else np.zeros((6, 6)))
+    vertical = [2, 3, 4]
+    if np.any(k[vertical, :] != 0) or np.any(k[:, vertical] != 0):
+        bad.append(f"bodies.{body.name}.stiffness has heave, roll or pitch terms and {name}'s hydrostatics would count "
+                   "the restoring twice: leave only mooring terms (surge, sway, yaw) in the body's stiffness")
+    return bad
 CURRENT_FORMATS = ("deeplines", "sima", "riflex")
 # keys that go with current_deck; the last three only with current_format = "riflex"
 CURRENT_DECK_KEYS = tuple(keys.CURRENT_DECK)

@@ -20,6 +20,8 @@ Parts (each also callable alone, see ``PARTS``):
   instance pool (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
+- waves: the `waves` effect's cost per step against the pythonfmu floor for 50, 200 and
+  1000 components, and per 100 components (``waves_cost``)
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
   case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
   took against the bonds' power (``ecco_cost``)
@@ -488,9 +490,27 @@ def part_longrun(out, quick):
     return [line]
 
 
+def part_waves(out, quick):
+    from . import waves_cost
+    rows = waves_cost.measure(out / "waves", rounds=2 if quick else 5, steps=200 if quick else 400)
+    if rows is None:
+        return [f"skipped: needs {waves_cost.DATA} (a repository checkout)"]
+    write_csv(out / "waves.csv", rows)
+    slope, ratio = waves_cost.linear(rows)
+    noisy = any(r["noisy"] for r in rows)
+    lines = [("too noisy to trust (spread between rounds above the floor's limit): " if noisy else "")
+             + f"waves effect per step: " + ", ".join(
+                 f"{r['components']} components {r['effect_us']:.0f} µs ({r['step_us']:.0f} µs the scene, "
+                 f"{r['step_x']:.2f}× its pythonfmu floor of {r['step_floor_us']:.0f} µs)" for r in rows)]
+    lines.append(f"linear: {slope:.1f} µs per 100 components through the FMU (cost per component at "
+                 f"{rows[-1]['components']} / at {rows[0]['components']}: {ratio:.2f}); the kernel alone "
+                 + ", ".join(f"{r['kernel_per_100_us']:.1f}" for r in rows) + " µs per 100 components")
+    return lines
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "startup": part_startup, "stability": part_stability,
-         "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun}
+         "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves}
 
 
 def main(out, parts=None, quick=False, log=print):

@@ -78,6 +78,25 @@ from ..physics.memory import StateSpace
 from ..physics.rigid_body import CoupledBodies, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
+from ..physics.waves import WaveLoad, components as wave_components
+
+# the sea-state knobs each spectrum exposes as waves.* parameters: (unit, description)
+WAVE_KNOBS = {
+    "height": ("m", "regular wave height H (crest to trough)"),
+    "period": ("s", "regular wave period T"),
+    "phase": ("deg", "regular wave phase at the global origin, t = 0"),
+    "hs": ("m", "significant wave height Hs = 4·sqrt(m0)"),
+    "tp": ("s", "spectral peak period Tp"),
+    "gamma": (None, "JONSWAP peak enhancement factor (>= 1)"),
+    "direction": ("deg", "wave direction, 'going to', counter-clockwise from global +x"),
+    "spreading": (None, "cos-2s spreading exponent s (0: long-crested)"),
+    "components": (None, "number of wave components"),
+    "seed": (None, "random seed of frequencies, phases and directions"),
+    "ramp": ("s", "length of the smooth start ramp"),
+}
+SPECTRUM_KNOBS = {"regular": ("height", "period", "phase", "direction", "ramp"),
+                  "jonswap": ("hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp"),
+                  "pierson_moskowitz": ("hs", "tp", "direction", "spreading", "components", "seed", "ramp")}
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -490,9 +509,11 @@ class LoadSlave(ArraySlave):
                              for e in self.loads.effects]
         self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
-        # every load output in one block: total, each effect, each coupling
-        self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings])]
-        self._load_total = np.r_[0.0, np.ones(len(self.effect_force) + len(self.couplings))]   # their sum
+        wave_force = self._add_waves(cfg.waves)
+        # every load output in one block: total, each effect, each coupling, the waves
+        self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
+                                     + wave_force)]
+        self._load_total = np.r_[0.0, np.ones(len(self.effect_force) + len(self.couplings) + len(wave_force))]
         # export mode: the mass contribution of acceleration loads, for the dynamics side
         if self.loads.uses_acceleration and not explicit:
             self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
@@ -506,6 +527,39 @@ class LoadSlave(ArraySlave):
         self.finish_registration()
         self.memories = []   # set up by start_physics
         self.stale = True
+
+    def _add_waves(self, cfg):
+        """The sea-state parameters waves.* (start values: the scene's) and the outputs
+        <name>.force, <name>.elevation; returns [the force slice] or [] without waves."""
+        self.wave, self.wave_cfg = None, cfg
+        if cfg is None:
+            return []
+        Par, Out = Fmi2Causality.parameter, Fmi2Causality.output
+        self.wave_knobs = {k: self.add(f"waves.{k}", Par, WAVE_KNOBS[k][0], cfg.sea[k], WAVE_KNOBS[k][1])
+                           for k in SPECTRUM_KNOBS[cfg.spectrum]}
+        force = self.add_vector(f"{cfg.name}.force", 6, Out, LIN_ROT["force"], None,
+                                "first-order wave excitation, global axes, about the reference point")
+        self.elevation = self.add(f"{cfg.name}.elevation", Out, "m", 0.0,
+                                  "wave elevation at the reference point's mean position")
+        self.depends([force, slice(self.elevation, self.elevation + 1)], [])
+        return [force]
+
+    def _start_waves(self):
+        """The wave kernel of the sea state the waves.* parameters hold now (one error naming
+        the knob when they are not a usable sea state)."""
+        cfg = self.wave_cfg
+        knobs = {k: float(self.values[vr]) for k, vr in self.wave_knobs.items()}
+        for k in ("components", "seed"):
+            if k in knobs and knobs[k] == int(knobs[k]):
+                knobs[k] = int(knobs[k])
+        sea = cfg.sea_state(**knobs)
+        g = float(self.values[self.g])
+        try:
+            sea.check()
+            comps = wave_components(sea, tuple(cfg.window))
+            self.wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
+        except ValueError as exc:
+            raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 
     def start_physics(self):
         """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
@@ -525,6 +579,8 @@ class LoadSlave(ArraySlave):
         self.memories = [(FeedthroughMemory(evs[0] if len(evs) == 1 else StateSpace.stack(evs)),
                           _joined([self.couplings[k]["velocity"] for k in ks]), _joined([first + k for k in ks]))
                          for evs, ks in self.memories]
+        if self.wave_cfg is not None:
+            self._start_waves()
         self.stale = True
 
     def evaluate(self):
@@ -535,13 +591,17 @@ class LoadSlave(ArraySlave):
             self.suspect = False
         v = self.values
         ne = len(self.loads.effects)
-        out = np.zeros((1 + ne + len(self.couplings), 6))   # total, effects, couplings
+        out = np.zeros((1 + ne + len(self.couplings) + (self.wave_cfg is not None), 6))   # total, effects, couplings, waves
         if ne:
             self.loads.effect_loads(self.motion(self.motion_inputs), self.env(), out[1:1 + ne])
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
             out[k] -= mass.dot(v[acc])
+        if self.wave is not None:   # the last row: a function of time only
+            w = self.wave(self.next_time or 0.0)
+            out[-1] = w[:6]
+            v[self.elevation] = w[6]
         out[0] = self._load_total.dot(out)   # (ndarray.dot: half the call cost of @ here)
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the
@@ -552,12 +612,14 @@ class LoadSlave(ArraySlave):
         # not stale: the inputs are those of the last evaluation, whose peek the step takes
         for mem, vel, _ in self.memories:
             mem.commit(self.values[vel], dt, peeked=not self.stale)
-        self.stale = bool(self.couplings)  # memory outputs move with time
+        self.stale = bool(self.couplings) or self.wave is not None  # memory and wave outputs move with time
 
     def physics_state(self):
-        return {"memory": [mem.state() for mem, _, _ in self.memories]}
+        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.wave is not None}
 
     def set_physics_state(self, state):
+        if state.get("waves") and self.wave is None:   # taken after initialization, restored before it
+            self._start_waves()
         saved = state["memory"]
         if len(saved) != len(self.memories):   # taken after initialization and restored before it, or back
             if saved:

@@ -2,7 +2,7 @@
 radiation, diffraction and Froude–Krylov forces, with hydrostatics and the rigid-body
 inertia (deep water, rho = 1025, g = 9.81).
 
-    pip install capytaine && python tests/data/bem/make_waves_data.py [OUTDIR]
+    pip install capytaine && python tests/data/bem/make_waves_data.py [OUTDIR [NAME.nc ...]]
 
 - ``wave_cylinder.nc``: one freely floating cylinder, axis through the origin, wave
   directions 0…90° every 15° (a heading outside them is an error the tests check);
@@ -11,8 +11,7 @@ inertia (deep water, rho = 1025, g = 9.81).
 
 Cylinder: radius 2 m, draft 4 m, rotation centre on the waterline at its axis, mass = the
 displaced mass, centre of mass 3 m below the waterline (stable in pitch), radii of gyration
-2 m (roll, pitch) and 1.5 m (yaw) about the centre of mass.  The frequency grid is
-0.1…3.5 rad/s every 0.1 rad/s and ω = ∞ (coarse on purpose: small files).
+2 m (roll, pitch) and 1.5 m (yaw) about the centre of mass.  Frequencies: 0.05…4 rad/s every 0.05 and ω = ∞.
 """
 import sys
 from pathlib import Path
@@ -24,7 +23,9 @@ import capytaine as cpt
 RADIUS, DRAFT, ZG = 2.0, 4.0, -3.0
 GYRATION = (2.0, 2.0, 1.5)
 RHO, G = 1025.0, 9.81
-OMEGA = np.append(np.round(np.arange(1, 36) * 0.1, 10), np.inf)
+# a uniform 0.05 rad/s grid to 4 rad/s (80 frequencies) and ω = ∞: the radiation kernels
+# are as long as 2π/Δω resolves (the cross-body ones carry the waves between the bodies)
+OMEGA = np.round(np.append(np.arange(1, 81) * 0.05, np.inf), 10)
 
 
 def rigid_inertia(mass, cog, centre):
@@ -64,12 +65,15 @@ def solve(bodies, directions, omega=OMEGA):
 
 def main(out):
     out = Path(out)
+    only = set(sys.argv[2:])
     cases = {"wave_cylinder.nc": (cylinder("cyl", 0.0), np.arange(0, 91, 15)),
              "wave_pair.nc": (cylinder("cyl1", -10.0) + cylinder("cyl2", 10.0), np.arange(0, 331, 30))}
     for name, (bodies, directions) in cases.items():
+        if only and name not in only:
+            continue
         ds = solve(bodies, directions)
         cpt.export_dataset(str(out / name), ds)
-        print(f"wrote {out / name}: {ds.sizes['radiating_dof']} dofs, {OMEGA.size} frequencies, "
+        print(f"wrote {out / name}: {ds.sizes['radiating_dof']} dofs, {ds.sizes['omega']} frequencies, "
               f"{len(directions)} directions, {(out / name).stat().st_size} bytes")
 
 
