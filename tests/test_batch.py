@@ -206,29 +206,9 @@ def test_sea_state_knobs_share_one_build(client, tmp_path):
     data = ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc"
     shutil.copy(data, tmp_path / data.name)
     scene = tmp_path / "sea.toml"
-    scene.write_text(f"""
-[run]
-step = 0.1
-stop = 60.0
-[waves]
-spectrum = "jonswap"
-hs = 1.0
-tp = 6.0
-ramp = 5.0
-components = 50
-[bodies.cyl]
-mass = 51191.7
-inertia = [204766.8, 204766.8, 115181.3]
-cog = [0.0, 0.0, -3.0]
-stiffness = [1e4, 1e4, 0.0, 0.0, 0.0, 1e5]      # mooring; the restoring in heave, roll, pitch: the dataset's
-damping = [2e4, 2e4, 4e4, 3e5, 3e5, 1e5]
-[[bodies.cyl.effects]]
-type = "wave_excitation"
-bem = "{data.name}"
-[[bodies.cyl.effects]]
-type = "bem_hydrostatics"
-bem = "{data.name}"
-""")
+    from hydrofmu.bench.waves_cost import SCENE as TEXT, WAVES   # the bench's floating cylinder
+    scene.write_text(TEXT.format(waves=WAVES.format(n=50) + "ramp = 5.0\n", data=data.name)
+                     .replace("stop = 10.0", "stop = 60.0").replace("step = 0.05", "step = 0.1"))
     outputs = ["cyl.waves.elevation", "cyl_dynamics.position[3]"]
     cases = tmp_path / "cases.toml"
     cases.write_text(f'scene = "{scene}"\noutputs = {json.dumps(outputs)}\ntransient = 10.0\n'
