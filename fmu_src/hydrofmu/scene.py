@@ -933,7 +933,13 @@ def _wave_effects(problems, bodies, sea, rho, g):
                 d["position0"], d["attitude0"] = list(body.position or [0.0] * 3), list(body.attitude or [0.0] * 3)
             for message in bad:
                 problems.add(f"{where}.bem", message)
-    if sea is None or not tfs:
+    if sea is None:
+        for where, _, _ in tfs:
+            problems.warn(where, "no [waves] in the scene: this body's wave excitation is left out of its FMU")
+        return
+    if not tfs:
+        if not problems.items:
+            problems.warn("waves", "no body has a wave_excitation effect: the sea state acts on nothing")
         return
     lo = max(tf.window[0] for _, _, tf in tfs)
     hi = min(tf.window[1] for _, _, tf in tfs)
