@@ -14,7 +14,8 @@ Conventions (README / user guide, Waves; DESIGN.md)
 
 Sea states (``SeaState``)
 -------------------------
-- regular: one component, a = H/2, ω = 2π/T, phase φ [deg], direction β.
+- regular: one component, a = H/2, ω = 2π/T, phase φ [deg], direction β (long-crested:
+  ``spreading`` does not apply).
 - jonswap (Hs, Tp, γ ≥ 1) and pierson_moskowitz (= jonswap with γ = 1):
   S(ω) = C·ω⁻⁵·exp(−5/4·(ω_p/ω)⁴)·γ^exp(−(ω − ω_p)²/(2σ²ω_p²)), σ = 0.07 (ω ≤ ω_p) or 0.09,
   C set so that 4·√m0 = Hs exactly (m0 integrated numerically).
@@ -207,8 +208,7 @@ def components(sea: SeaState, window=(0.0, math.inf)) -> Components:
         if not window[0] - 1e-9 <= w[0] <= window[1] + 1e-9:
             raise WaveError("period", f"{sea.period:g} s (ω = {w[0]:.4g} rad/s) is outside the transfer functions' "
                                       f"frequencies {window[0]:.4g}…{window[1]:.4g} rad/s")
-        beta = np.array([sea.direction + (_spread(rng, sea.spreading, 1)[0] if sea.spreading > 0 else 0.0)])
-        return Components(w, np.array([sea.height / 2]), beta, np.radians([sea.phase]))
+        return Components(w, np.array([sea.height / 2]), np.array([sea.direction]), np.radians([sea.phase]))
     gamma = 1.0 if sea.spectrum == "pierson_moskowitz" else sea.gamma
     lo, hi, outside = band(sea.tp, gamma, window)
     if outside > MAX_OUTSIDE:
