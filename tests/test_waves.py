@@ -142,6 +142,11 @@ def test_direction_interpolation_and_wrap():
         # (the BEM mesh is symmetric to ~0.6 % of the peak at the shortest waves, 3.75 rad/s)
         assert np.all(np.abs(a - b * mirror) <= 1e-2 * scale)
         np.testing.assert_allclose(tf.at(pair.omega, np.full(pair.omega.size, 370.0)), b)
+        # a file that solved 360° as well as 0° (Capytaine's 2π, WAMIT's 360): one direction
+        x = pair.body(name)
+        both = TransferFunction(pair.omega, np.append(pair.directions, 360.0), np.concatenate((x, x[:, :1]), axis=1),
+                                position=tf.position)
+        np.testing.assert_allclose(both.at(pair.omega, np.full(pair.omega.size, 350.0)), a)
 
 
 def test_jonswap_and_pm_spectra():

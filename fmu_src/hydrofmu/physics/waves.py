@@ -250,7 +250,10 @@ class TransferFunction:
     def __init__(self, omega, directions, values, position=(0.0, 0.0), g=9.81, depth=math.inf):
         self.omega = np.asarray(omega, dtype=float)
         d = np.mod(np.asarray(directions, dtype=float), 360.0)
-        order = np.argsort(d)
+        d[d > 360.0 - DIRECTION_TOL] = 0.0
+        order = np.argsort(d, kind="stable")
+        keep = np.concatenate(([True], np.diff(d[order]) > DIRECTION_TOL))   # 0° and 360° solved both: one
+        order = order[keep]
         self.directions = d[order]
         values = np.asarray(values, dtype=complex)[:, order]
         self.position = np.asarray(position, dtype=float)[:2]
