@@ -383,7 +383,7 @@ def _wave_excitation(problems, table, where):
     """First-order wave excitation from a BEM result (Capytaine .nc, WAMIT .3 / .2): the
     transfer functions of one BEM body; the sea state is the scene's [waves]."""
     from .decks.bem_waves import read_excitation
-    problems.known_keys(table, where, {"type", "name", "bem", "body", "ulen"})
+    problems.known_keys(table, where, keys.effect_keys("wave_excitation", False))
     data, path, body = _bem_entry(problems, table, where, read_excitation)
     if data is None:
         return None
@@ -397,7 +397,7 @@ def _wave_excitation(problems, table, where):
 def _bem_hydrostatics(problems, table, where):
     """Hydrostatic restoring −C·(η − η0) from a BEM result (Capytaine .nc, WAMIT .hst)."""
     from .decks.bem_waves import read_hydrostatics
-    problems.known_keys(table, where, {"type", "name", "bem", "body", "ulen"})
+    problems.known_keys(table, where, keys.effect_keys("bem_hydrostatics", False))
     data, path, body = _bem_entry(problems, table, where, read_hydrostatics)
     if data is None:
         return None
