@@ -41,3 +41,39 @@ def test_gauss_seidel_is_refused_not_switched(demo_build, capsys):
     err = capsys.readouterr().err
     assert code == 2 and err.startswith("error: --algorithm: algorithm:") and "--algorithm jacobi" in err
     assert main(["run", str(demo_build), "--engine", "libcosim", "--algorithm", "jacobi", "--stop", "0.2"]) == 0
+
+
+def test_libcosim_honours_the_scenes_outputs_and_interval(tmp_path):
+    """A scene's [run] outputs and interval: libcosim records the same columns at the same
+    times as our master (Jacobi: the same numbers), the CLI writes them the same way, and an
+    ECCO run asked for an interval is refused naming the scene file and key."""
+    from hydrofmu.cli import main
+    from hydrofmu.errors import InputError
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    from conftest import MODELS
+    scene = tmp_path / "thin.toml"
+    scene.write_text((MODELS / "moored_barge.toml").read_text().replace('"decks/', f'"{MODELS}/decks/').replace(
+        'substep = 0.02', 'substep = 0.02\noutputs = ["barge.position", "barge.force[1]"]\ninterval = 0.5'))
+    built = build_scene(load_scene(scene), tmp_path / "fmus", log=lambda *_: None)
+    ours = master.run(built, stop=20.0, algorithm="jacobi", progress=False)
+    theirs = libcosim.run(built, stop=20.0, algorithm="jacobi")
+    assert theirs.columns == ours.columns and len(ours.columns) == 4, ours.columns
+    np.testing.assert_array_equal(theirs.time, np.arange(41) * 0.5)
+    np.testing.assert_array_equal(theirs.time, ours.time)
+    assert theirs.step == ours.step == 0.5
+    assert np.ptp(ours["barge_dynamics.position[1]"]) > 0.01
+    np.testing.assert_allclose(theirs.values, ours.values, rtol=1e-9, atol=1e-9)
+    # the run's own outputs/interval win over the scene's, as in our master
+    got = libcosim.run(built, stop=2.0, algorithm="jacobi", outputs=["barge_dynamics.position[3]"], interval=0.2)
+    assert got.columns == ["barge_dynamics.position[3]"] and np.allclose(got.time, np.arange(11) * 0.2)
+    # the CLI writes the same CSV layout from either engine
+    for engine in ("fmpy", "libcosim"):
+        assert main(["run", str(built), "--engine", engine, "--algorithm", "jacobi", "--stop", "2",
+                     "--csv", str(tmp_path / f"{engine}.csv")]) == 0
+    assert (tmp_path / "fmpy.csv").read_text().splitlines()[0] == (tmp_path / "libcosim.csv").read_text().splitlines()[0]
+    assert len((tmp_path / "libcosim.csv").read_text().splitlines()) == 1 + 5
+    with pytest.raises(InputError, match=r"thin.toml.*run.interval.*ECCO chooses its own time points"):
+        libcosim.run(built, stop=2.0, algorithm="ecco")
+    with pytest.raises(InputError, match="interval: the output interval must be a whole number of steps"):
+        libcosim.run(built, stop=2.0, algorithm="jacobi", interval=0.25)

@@ -173,12 +173,12 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     parameters : mapping, optional
         ``{'instance.variable': value}`` set in initialization mode (fmpy engine).
     outputs : sequence of str, optional
-        What to record by name (fmpy engine): body names (position and attitude),
+        What to record by name: body names (position and attitude),
         ``body.position`` (``attitude``, ``velocity``, ``acceleration``) or
         ``instance.variable``; default: the scene's ``[run] outputs``, else every output.
     interval : float, optional
-        Output interval [s], a whole number of steps (fmpy engine); default: the scene's
-        ``[run] interval``, else every step.
+        Output interval [s], a whole number of steps (an ECCO run has none); default: the
+        scene's ``[run] interval``, else every step.
     parquet, csv : str or Path, optional
         Stream the rows into these files as the run goes (fmpy engine; bounded memory): the
         Result is then a ``cosim.stream.FileResult`` reading its columns from the Parquet file.
@@ -228,12 +228,13 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
     from .cosim.libcosim import engine_for
     engine = engine_for(folder, algorithm, engine)
     if engine == "libcosim":
-        for key, value in (("outputs", outputs), ("interval", interval), ("parquet", parquet), ("csv", csv)):
+        for key, value in (("parquet", parquet), ("csv", csv)):
             if value is not None:
-                raise InputError("run", None, key, "the libcosim engine records every output at every step in "
-                                                   "memory: use engine='fmpy'")
+                raise InputError("run", None, key, "the libcosim engine holds its run in memory and writes "
+                                                   "nothing as it goes: use engine='fmpy', or Result.to_csv after it")
         from .cosim.libcosim import run as run_libcosim
-        return run_libcosim(folder, stop=stop, step=step, record=record, algorithm=algorithm)
+        return run_libcosim(folder, stop=stop, step=step, record=record, algorithm=algorithm, outputs=outputs,
+                            interval=interval)
     from .cosim.master import run as run_fmpy
     from .cosim.stream import Sink
     return run_fmpy(folder, stop=stop, step=step, algorithm=algorithm, record=record, parameters=parameters,

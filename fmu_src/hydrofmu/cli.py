@@ -103,19 +103,16 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
-        for key in ("outputs", "interval"):
-            if kw.pop(key, None) is not None:
-                raise InputError("command line", None, f"--{key}", "the libcosim engine records every output at "
-                                                                   "every step: use --engine fmpy")
         from .cosim.libcosim import run
         say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
-        result = run(folder, **kw)
-        result.stats = result.summary(transient)
+        try:
+            result = run(folder, **kw)
+        except InputError as exc:   # the run's own --outputs/--interval, named as the command line says them
+            raise _as_option(exc) from None
         result.written = {}
-        for path, write in ((csv, result.to_csv), (png, result.plot), (summary, result.stats.to_json)):
-            if path:
-                result.written[Path(path)] = keep(write, path, log)[0]
-        return result
+        if csv:
+            result.written[Path(csv)] = keep(result.to_csv, csv, log)[0]
+        return _plot_and_summary(result, png, summary, transient, log)
     from .cosim.master import run
     from .cosim.stream import Sink
     if parquet is None and csv is not None and _has_pyarrow():
@@ -125,10 +122,20 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     try:
         result = run(folder, sink=Sink(parquet, csv) if parquet or csv else None, **kw)
     except InputError as exc:   # the run's own --outputs/--interval, named as the command line says them
-        if exc.path == "run" and exc.field in ("outputs", "interval"):
-            raise InputError("command line", None, f"--{exc.field}", exc.message) from None
-        raise
+        raise _as_option(exc) from None
     result.written = {Path(asked): Path(got) for asked, got in getattr(result, "written", {}).items()}
+    return _plot_and_summary(result, png, summary, transient, log)
+
+
+def _as_option(exc):
+    """An InputError about the run's own outputs/interval, named as the command line says them."""
+    if exc.path == "run" and exc.field in ("outputs", "interval"):
+        return InputError("command line", None, f"--{exc.field}", exc.message)
+    return exc
+
+
+def _plot_and_summary(result, png, summary, transient, log):
+    """The PNG and the summary of a run (each engine's), when it recorded what they need."""
     missing = _unplotted(result)
     if png and missing:
         log(f"warning: no PNG: the plot needs every output of the bodies' FMUs, and {missing} was not "

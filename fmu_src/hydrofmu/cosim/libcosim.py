@@ -23,17 +23,23 @@ from .bonds import columns, power_bonds
 from .manifest import read_manifest
 from .master import check_names, check_steps, run_settings
 from .result import Result, column_units
+from .stream import output_every, select
 
 NS = 1_000_000_000
 
 
-def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
+def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None, outputs=None, interval=None):
     """Run the scene built in ``folder`` (its manifest.json) in libcosim; returns a Result
-    with the same columns as cosim.master.run (default: every output of every FMU).
+    with the same columns and time points as cosim.master.run (default: every output of
+    every FMU, every step).
     ``algorithm`` (default: the scene's) must be 'jacobi' or 'ecco': InputError otherwise.
+    ``outputs``, ``interval``: as for ``cosim.master.run`` (default: the scene's ``[run]
+    outputs`` and ``interval``): only the chosen columns are observed, and one row in
+    ``interval / step`` is kept (libcosim's observer holds every step of those columns).
     ``ecco``: ECCO settings over the scene's (``{'rel_tolerance': 1e-4}``, keys of ``[run.ecco]``).
-    An ECCO run's time points are the ones it chose; it ends at the first at or after
-    ``stop``, and its Result records every power bond's force and velocity too."""
+    An ECCO run's time points are the ones it chose (an output interval is refused); it
+    ends at the first at or after ``stop``, and its Result records every power bond's
+    force and velocity too."""
     from libcosimpy.CosimAlgorithm import CosimAlgorithm, EccoParams
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
@@ -54,6 +60,17 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
     stop = manifest["run"]["stop"] if stop is None else stop
     step = manifest["run"]["step"] if step is None else step
     check_steps(stop, step, wanted, "run")
+    source = manifest.get("source", folder / "manifest.json")
+    # the scene's [run] outputs / interval unless the run names its own (as cosim.master.run)
+    out_where = ("run", "outputs") if outputs is not None else (source, "run.outputs")
+    outputs = manifest["run"].get("outputs") if outputs is None and record is None else outputs
+    int_where = ("run", "interval") if interval is not None else (source, "run.interval")
+    interval = manifest["run"].get("interval") if interval is None else interval
+    if wanted == "ecco" and interval is not None:
+        raise InputError(*int_where[:1], None, int_where[1],
+                         f"an output interval ({interval:g} s) needs a fixed step: ECCO chooses its own time "
+                         "points (run it without an interval, or with --algorithm jacobi)")
+    thin = output_every(interval, step, *int_where) if wanted != "ecco" else 1
     step_ns = int(round(step * NS))
     settings = run_settings(manifest, step, wanted, stop)
     if wanted == "ecco":
@@ -75,7 +92,7 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
         execution = CosimExecution.from_step_size(step_size=step_ns)
         n = int(round(stop / step))
         capacity = n + 1
-    index, refs, outputs = {}, {}, {}
+    index, refs, outs = {}, {}, {}
     for name in manifest["order"]:
         fmu = str((folder / manifest["instances"][name]["fmu"]).resolve())
         slave = CosimLocalSlave(fmu_path=fmu, instance_name=name)
@@ -84,13 +101,14 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
             raise RuntimeError(f"libcosim could not load {fmu}")
         variables = execution.slave_variables(index[name])
         refs[name] = {v.name.decode(): v.reference for v in variables}
-        outputs[name] = [v.name.decode() for v in variables if v.causality == 2]  # 2 = output
+        outs[name] = [v.name.decode() for v in variables if v.causality == 2]  # 2 = output
     for src, svar, dst, dvar in manifest["connections"]:
         if execution.connect_real_variables(index[src], refs[src][svar], index[dst], refs[dst][dvar]) != 0:
             raise RuntimeError(f"libcosim could not connect {src}.{svar} -> {dst}.{dvar}")
-    if record is None:
-        record = [f"{name}.{var}" for name in manifest["order"] for var in outputs[name]]
-    record = list(record)
+    every = [f"{name}.{var}" for name in manifest["order"] for var in outs[name]]
+    if record is None and outputs:
+        record = select(manifest, outputs, every, *out_where)
+    record = list(every if record is None else record)
     check_names(record, [f"{name}.{var}" for name in manifest["order"] for var in refs[name]], "run", "record",
                 "'instance.variable'")
     if wanted == "ecco":
@@ -131,8 +149,10 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None):
     if wanted == "ecco":
         time = times / NS
         step = float(np.mean(np.diff(time))) if time.size > 1 else step
-    else:
-        time = np.arange(n + 1) * step
+    else:   # the rows our master keeps: every point k with k % thin == 0
+        time = np.arange(n + 1)[::thin] * step
+        values = [v[::thin] for v in values]
+        step = thin * step   # the Result's step: its rows' spacing, as our master's
     return Result(time, record, np.column_stack(values), wanted if wanted == "ecco" else "libcosim", step,
                   manifest["dynamics"], settings, column_units(folder, manifest, record), manifest)
 
