@@ -85,3 +85,52 @@ def demo_build(tmp_path_factory):
     from hydrofmu.scene import load_scene
     out = tmp_path_factory.mktemp("demo")
     return build_scene(load_scene(MODELS / "moored_barge.toml"), out, log=lambda *_: None)
+
+
+def coupled_pair_scene(deck, bodies, mode="explicit", stop=4.0, extra=""):
+    """Scene text of the coupled-body tests (test_inprocess, test_start_values): ``bodies``
+    [(name, y, acceleration_loads, velocity, attitude or None, z)], each of mass 1e6 kg; body
+    'a' in a 1.5 m/s current with drag and a massive soft ball joint to the earth (its
+    acceleration loads ``mode``); SIMO couplings SA (convolution), SB (state space) and AB
+    (convolution) of the pair deck ``deck``; ``extra``: more tables (TOML)."""
+    text = f"""
+[environment]
+current_speed = 1.5
+current_direction = 30.0
+[run]
+step = 0.05
+stop = {stop}
+substep = 0.01
+"""
+    for name, y, loads, velocity, attitude, z in bodies:
+        text += f"""
+[bodies.{name}]
+position = [0.0, {y}, {z}]
+{f"attitude = {attitude}" if attitude else ""}
+velocity = {velocity}
+mass = 1.0e6
+inertia = [1e8, 1.2e8, 1.5e8]
+stiffness = [1e5, 1e5, 1e6, 1e8, 1e8, 1e8]
+acceleration_loads = "{loads}"
+"""
+    text += f"""
+[[bodies.a.effects]]
+type = "aqwa_viscous_drag"
+matrix = [2e4, 3e4, 1e4, 0.0, 0.0, 1e6]
+option = "RELATIVE"
+[joints.pin]
+a = "a"
+a_point = [10.0, 0.0, -2.0]
+stiffness = 2.0e5
+damping = 2.0e5
+am = 2.0e4
+cd = [1e3, 1e3, 1e3]
+added_mass = [1e4, 1e4, 1e4]
+acceleration_loads = "{mode}"
+""" + extra
+    return text + "".join(f"""
+[[couplings]]
+deck = "{deck}"
+coupling = "{c}"
+method = "{method}"
+""" for c, method in (("SA", "convolution"), ("SB", "state_space"), ("AB", "convolution")))

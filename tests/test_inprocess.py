@@ -7,7 +7,7 @@ from hydrofmu.cosim import inprocess
 from hydrofmu.cosim.master import RunError, run
 from hydrofmu.scene import load_scene
 
-from conftest import build, write_scene
+from conftest import build, coupled_pair_scene, write_scene
 from simo_decks import pair_deck
 
 M = 1.0e6
@@ -16,44 +16,9 @@ M = 1.0e6
 def scene_text(deck):
     """Body a (explicit, drag in a current, a soft ball joint with a massive node to the earth)
     and body b (export), coupled by SIMO self and cross added mass and memory."""
-    body = lambda n, y, mode: f"""
-        [bodies.{n}]
-        position = [0.0, {y}, 0.0]
-        velocity = [0.3, -0.2, 0.1, 0.0, 0.0, 0.01]
-        mass = {M}
-        inertia = [1e8, 1e8, 1e8]
-        stiffness = [1e5, 1e5, 1e6, 1e8, 1e8, 1e8]
-        acceleration_loads = "{mode}"
-        """
-    return """
-        [environment]
-        current_speed = 1.5
-        current_direction = 30.0
-        [run]
-        step = 0.05
-        stop = 4.0
-        substep = 0.01
-        """ + body("a", 0.0, "explicit") + """
-        [[bodies.a.effects]]
-        type = "aqwa_viscous_drag"
-        matrix = [2e4, 3e4, 1e4, 0.0, 0.0, 1e6]
-        option = "RELATIVE"
-        """ + body("b", 40.0, "export") + """
-        [joints.pin]
-        a = "a"
-        a_point = [10.0, 0.0, -2.0]
-        stiffness = 2.0e5
-        damping = 2.0e5
-        am = 2.0e4
-        cd = [1e3, 1e3, 1e3]
-        added_mass = [1e4, 1e4, 1e4]
-        acceleration_loads = "explicit"
-        """ + "".join(f"""
-        [[couplings]]
-        deck = "{deck}"
-        coupling = "{c}"
-        method = "{method}"
-        """ for c, method in (("SA", "convolution"), ("SB", "state_space"), ("AB", "convolution")))
+    velocity = [0.3, -0.2, 0.1, 0.0, 0.0, 0.01]
+    return coupled_pair_scene(deck, [("a", 0.0, "explicit", velocity, None, 0.0),
+                                     ("b", 40.0, "export", velocity, None, 0.0)])
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,7 @@ from hydrofmu import assembly
 from hydrofmu.cosim.master import run
 from hydrofmu.fmi.starts import StartValueError
 
-from conftest import build, open_fmus
+from conftest import build, coupled_pair_scene, open_fmus
 from simo_decks import pair_deck
 
 M = 1.0e6
@@ -24,53 +24,18 @@ def scene_text(deck, mode):
     velocity from a tilted pose; a in a current with drag and a massive ball joint to the
     earth (``mode`` too), b and c joined by a ball joint; SIMO self and cross couplings
     with memory (convolution and state space) between a and b."""
-    body = lambda n, y, mode, att, vel: f"""
-        [bodies.{n}]
-        position = [0.0, {y}, -1.0]
-        attitude = {att}
-        velocity = {vel}
-        mass = {M}
-        inertia = [1e8, 1.2e8, 1.5e8]
-        stiffness = [1e5, 1e5, 1e6, 1e8, 1e8, 1e8]
-        acceleration_loads = "{mode}"
-        """
-    return """
-        [environment]
-        current_speed = 1.5
-        current_direction = 30.0
-        [run]
-        step = 0.05
-        stop = 2.0
-        substep = 0.01
-        """ + body("a", 0.0, mode, [0.05, -0.03, 0.2], [0.3, -0.2, 0.1, 0.01, -0.02, 0.03]) + """
-        [[bodies.a.effects]]
-        type = "aqwa_viscous_drag"
-        matrix = [2e4, 3e4, 1e4, 0.0, 0.0, 1e6]
-        option = "RELATIVE"
-        """ + body("b", 40.0, "export", [-0.04, 0.02, -0.1], [0.1, 0.5, 0.2, 0.0, 0.01, -0.02]) + body(
-        "c", 80.0, "export", [0.0, 0.03, 0.05], [-0.2, 0.1, 0.0, 0.02, 0.0, 0.01]) + f"""
-        [joints.pin]
-        a = "a"
-        a_point = [10.0, 0.0, -2.0]
-        stiffness = 2.0e5
-        damping = 2.0e5
-        am = 2.0e4
-        cd = [1e3, 1e3, 1e3]
-        added_mass = [1e4, 1e4, 1e4]
-        acceleration_loads = "{mode}"
-        [joints.link]
-        a = "b"
-        a_point = [20.0, 0.0, 0.0]
-        b = "c"
-        b_point = [-20.0, 0.0, 0.0]
-        stiffness = 1.0e6
-        damping = 1.0e5
-        """ + "".join(f"""
-        [[couplings]]
-        deck = "{deck}"
-        coupling = "{c}"
-        method = "{method}"
-        """ for c, method in (("SA", "convolution"), ("SB", "state_space"), ("AB", "convolution")))
+    return coupled_pair_scene(deck, [
+        ("a", 0.0, mode, [0.3, -0.2, 0.1, 0.01, -0.02, 0.03], [0.05, -0.03, 0.2], -1.0),
+        ("b", 40.0, "export", [0.1, 0.5, 0.2, 0.0, 0.01, -0.02], [-0.04, 0.02, -0.1], -1.0),
+        ("c", 80.0, "export", [-0.2, 0.1, 0.0, 0.02, 0.0, 0.01], [0.0, 0.03, 0.05], -1.0)], mode, stop=2.0, extra="""
+[joints.link]
+a = "b"
+a_point = [20.0, 0.0, 0.0]
+b = "c"
+b_point = [-20.0, 0.0, 0.0]
+stiffness = 1.0e6
+damping = 1.0e5
+""")
 
 
 @pytest.fixture(scope="module", params=["export", "explicit"])
