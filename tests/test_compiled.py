@@ -47,9 +47,10 @@ def compiled_slave(fmu, unzipped, name="compiled"):
     return md, s
 
 
-def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0):
+def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0, params=None):
     """(Python outputs, compiled outputs, output names) of both flavours of ``fmu`` driven
-    by the same inputs: rows are communication points, columns outputs."""
+    by the same inputs (and the parameters ``params`` {name: value} it has, set in
+    initialization mode): rows are communication points, columns outputs."""
     unzipped = Path(tmp) / Path(fmu).stem
     with zipfile.ZipFile(fmu) as z:
         z.extractall(unzipped)
@@ -64,11 +65,15 @@ def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0):
     amp = np.array([AMPLITUDE.get(v.unit, 1.0) for v in ins])
     freq, phase = rng.uniform(0.02, 0.3, len(ins)), rng.uniform(0.0, 2 * np.pi, len(ins))
     vin, vout = [v.valueReference for v in ins], [v.valueReference for v in outs]
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    pars = {refs[k]: float(v) for k, v in (params or {}).items() if k in refs}
     py.setup_experiment(0.0)
     py.enter_initialization_mode()
+    py.set_real(list(pars), list(pars.values()))
     py.exit_initialization_mode()
     c.setupExperiment(startTime=0.0)
     c.enterInitializationMode()
+    c.setReal(list(pars), list(pars.values()))
     c.exitInitializationMode()
     p_rows, c_rows = [], []
     for n in range(steps):
@@ -85,13 +90,14 @@ def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0):
     return np.array(p_rows), np.array(c_rows), [v.name for v in outs]
 
 
-def assert_equal_flavours(folder, tmp, steps=STEPS, dt=0.1, seed=0):
-    """Every output of every FMU of a built scene folder: compiled = Python to 1e-10 of its range."""
-    fmus = sorted(Path(folder).glob("*.fmu"))
+def assert_equal_flavours(folder, tmp, steps=STEPS, dt=0.1, seed=0, params=None, loads_only=False):
+    """Every output of every FMU (``loads_only``: of every load FMU) of a built scene folder:
+    compiled = Python to 1e-10 of its range."""
+    fmus = [f for f in sorted(Path(folder).glob("*.fmu")) if not (loads_only and f.stem.endswith("_dynamics"))]
     assert fmus
     worst = 0.0
     for fmu in fmus:
-        p, c, names = drive(fmu, tmp, steps, dt, seed)
+        p, c, names = drive(fmu, tmp, steps, dt, seed, params)
         assert np.isfinite(p).all()
         span = p.max(axis=0) - p.min(axis=0)
         scale = np.where(span > 0, span, np.abs(p).max(axis=0))
@@ -533,9 +539,10 @@ def test_native_floor_copies_its_inputs_and_times_in_the_c_host(tmp_path):
 
 def test_every_effect_kernel_has_a_compiled_twin(tmp_path):
     """A load FMU holding one effect of every kernel type a scene reaches (explicit mode, a
-    current profile): compiled = Python to 1e-10 of each output's range.  A kernel without
-    a C twin is refused by a compiled build, naming the effect."""
-    from hydrofmu import InputError, description as d
+    current profile, hydrostatics about a tilted and yawed initial pose): compiled = Python to
+    1e-10 of each output's range."""
+    from hydrofmu import description as d
+    from hydrofmu.physics.loads import KERNELS
     from hydrofmu.assembly import Instance
     from hydrofmu.fmi.cbuild import build_c_fmu
     rng = np.random.default_rng(5)
@@ -547,7 +554,10 @@ def test_every_effect_kernel_has_a_compiled_twin(tmp_path):
                                     "point": [3.0, -2.0, -4.0], "surface": 1500.0},
         "riflex_body": {"offset": [10.0, -5.0, -3.0], "am": 2e5, "ae": 150.0, "icoo": "LOCAL", "cd": [3e3, 4e3, 5e3],
                         "added_mass": [1e4, 2e4, 3e4]},
+        "bem_hydrostatics": {"stiffness": (np.diag([0, 0, 3e7, 9e8, 2e10, 0.0]) + rng.uniform(-1e5, 1e5, (6, 6))).tolist(),
+                             "position0": [1.0, 2.0, 0.0], "attitude0": [0.01, -0.02, 0.3]},
     }
+    assert set(data) == set(KERNELS)   # a kernel added without its C twin fails here
     env = d.Environment(1025.0, 9.81, 1.1, 30.0, np.array([[0.0, 1.1, 30.0], [-20.0, 0.5, 60.0]]))
 
     def load_fmu(effects):
@@ -556,11 +566,6 @@ def test_every_effect_kernel_has_a_compiled_twin(tmp_path):
 
     build_c_fmu(Instance("hull", "every_effect", "load", "hull", load_fmu(data), {}, []), tmp_path)
     assert assert_equal_flavours(tmp_path / "fmus", tmp_path) <= 1e-10
-    # not yet compiled: the BEM hydrostatic restoring (physics/hydrostatics.py)
-    hydrostatics = {"bem_hydrostatics": {"stiffness": np.diag([0, 0, 3e7, 9e8, 2e10, 0.0]).tolist(),
-                                         "position0": [0.0, 0.0, 0.0], "attitude0": [0.0, 0.0, 0.0]}}
-    with pytest.raises(InputError, match="e0.*Hydrostatics has no compiled kernel yet"):
-        build_c_fmu(Instance("hull", "no_twin", "load", "hull", load_fmu(hydrostatics), {}, []), tmp_path / "n")
 
 
 def test_scene_build_runtime_and_cli_flag_choose_the_flavour(tmp_path):
@@ -589,29 +594,157 @@ def test_scene_build_runtime_and_cli_flag_choose_the_flavour(tmp_path):
 
 
 def test_wave_kernel_equals_the_python_one(tmp_path):
-    """physics/waves.c (compiled alone here) against physics.waves.WaveLoad: a JONSWAP sea
-    with spreading through a random transfer function, inside and after the start ramp, to
-    1e-12 of each output's range."""
+    """physics/waves.c (compiled alone here) against physics.waves: the components it draws
+    (numpy's default_rng reproduced: seeds below and above 2**32) and the excitation and
+    elevation through a random transfer function (directions round the circle, a direction
+    across 360 deg; and directions that are not), inside and after the start ramp, to 1e-12 of
+    each output's range."""
     import ctypes
     from hydrofmu.cc import cached_many
     from hydrofmu.physics.waves import SeaState, TransferFunction, WaveLoad, components
     physics = Path(__import__("hydrofmu").__file__).parent / "physics"
     lib = ctypes.CDLL(str(cached_many([physics / "waves.c"], "waves_kernel", libs=["-lm"],
                                       flags=["-O2", "-shared", "-fPIC", "-std=c99"])))
+    lib.hf_wave_build.restype = ctypes.POINTER(ctypes.c_double)
+
+    class Sea(ctypes.Structure):
+        _fields_ = [("spectrum", ctypes.c_int)] + [(k, ctypes.c_double) for k in (
+            "height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp",
+            "depth")]
+
     rng = np.random.default_rng(3)
-    omega, directions = np.linspace(0.2, 2.0, 19), np.array([0.0, 90.0, 180.0, 270.0])
-    values = rng.normal(size=(19, 4, 6)) + 1j * rng.normal(size=(19, 4, 6))
-    sea = SeaState("jonswap", hs=3.0, tp=9.0, spreading=4.0, components=60, seed=7, ramp=20.0)
-    wave = WaveLoad(components(sea, (0.2, 2.0)), TransferFunction(omega, directions, 1e5 * values, (12.0, -5.0)),
-                    (12.0, -5.0), sea.ramp)
-    params = (ctypes.c_double * len(wave.c_params()))(*wave.c_params())
-    out = (ctypes.c_double * 7)()
-    times = np.linspace(-1.0, 200.0, 2011)
-    ref, got = [], []
-    for t in times:
-        lib.hf_waves(params, ctypes.c_double(t), out)
-        got.append(list(out))
-        ref.append(wave(t))
-    ref, got = np.array(ref), np.array(got)
-    span = ref.max(axis=0) - ref.min(axis=0)
-    assert (span > 0).all() and np.all(np.abs(got - ref).max(axis=0) <= 1e-12 * span)
+    omega = np.linspace(0.2, 2.0, 19)
+    cases = [(np.array([0.0, 90.0, 180.0, 270.0]), SeaState("jonswap", hs=3.0, tp=9.0, spreading=4.0, components=60,
+                                                             seed=7, ramp=20.0, direction=350.0)),
+             (np.array([0.0, 30.0, 60.0]), SeaState("pierson_moskowitz", hs=2.0, tp=11.0, components=40,
+                                                    seed=2 ** 40 + 3, direction=45.0, depth=30.0)),
+             (np.array([90.0, 30.0, 60.0]), SeaState("regular", height=2.0, period=6.0, phase=30.0, direction=70.0,
+                                                     ramp=5.0))]
+    for directions, sea in cases:
+        values = 1e5 * (rng.normal(size=(19, directions.size, 6)) + 1j * rng.normal(size=(19, directions.size, 6)))
+        tf = TransferFunction(omega, directions, values, (12.0, -5.0), 9.81, sea.depth)
+        wave = WaveLoad(components(sea, (0.2, 2.0)), tf, (12.0, -5.0), sea.ramp, 9.81, sea.depth)
+        spec = {"regular": 0, "jonswap": 1, "pierson_moskowitz": 2}[sea.spectrum]
+        c_sea = Sea(spec, *(float(getattr(sea, f)) for f, _ in Sea._fields_[1:]))
+        record = tf.c_params((0.2, 2.0))
+        field, message = ctypes.create_string_buffer(16), ctypes.create_string_buffer(400)
+        params = lib.hf_wave_build(ctypes.byref(c_sea), (ctypes.c_double * len(record))(*record),
+                                   ctypes.c_double(9.81), field, message, ctypes.c_size_t(400))
+        assert params, message.value
+        n = wave.omega.size
+        assert int(params[0]) == n and np.allclose(params[2:2 + n], wave.omega, rtol=1e-13, atol=0)
+        out = (ctypes.c_double * 7)()
+        ref, got = [], []
+        for t in np.linspace(-1.0, 200.0, 2011):
+            lib.hf_waves(params, ctypes.c_double(t), out)
+            got.append(list(out))
+            ref.append(wave(t))
+        ref, got = np.array(ref), np.array(got)
+        span = ref.max(axis=0) - ref.min(axis=0)
+        assert (span > 0).all() and np.all(np.abs(got - ref).max(axis=0) <= 1e-12 * span), sea
+        ctypes.CDLL(None).free(params)
+
+
+# -- waves and hydrostatics -------------------------------------------------------------------
+
+def wave_scene(tmp, bem, bodies, waves, method=None):
+    """A scene of floating cylinders of the BEM test datasets (tests/test_waves_fmu.py):
+    wave excitation, BEM hydrostatics, radiation memory by ``method`` (None: no radiation; the
+    memories are held against the Python flavour on the other scenes, and a state-space fit and
+    the BEM report cost seconds); ``bodies`` {name: x}."""
+    from test_waves_fmu import scene_text
+    shutil.copy(bem, Path(tmp) / bem.name)
+    text = scene_text(bem, bodies, [1e4, 1e4, 2e4, 1e6, 1e6, 1e6], waves, step=0.1, method=method or "convolution",
+                      radiation=method is not None)
+    (Path(tmp) / "waves.toml").write_text(text)
+    return Path(tmp) / "waves.toml"
+
+
+WAVE_SCENES = {
+    # one cylinder (its BEM directions 0...90 deg do not go round the circle)
+    "regular": ("wave_cylinder.nc", {"cyl": 0.0}, 'spectrum = "regular"\nheight = 2.0\nperiod = 7.0\n'
+                'direction = 30.0\nphase = 10.0\nramp = 10.0', None,
+                {"waves.period": 8.5, "waves.direction": 60.0, "waves.phase": -40.0, "waves.height": 1.5}),
+    # the pair 10 m either side of the origin (directions all round: a direction across 360 deg)
+    "irregular": ("wave_pair.nc", {"cyl1": -10.0, "cyl2": 10.0}, 'spectrum = "jonswap"\nhs = 3.0\ntp = 9.0\n'
+                  'gamma = 2.0\ndirection = 200.0\nspreading = 6.0\ncomponents = 80\nseed = 5\nramp = 15.0',
+                  None, {"waves.hs": 2.5, "waves.seed": 11, "waves.direction": 355.0, "waves.gamma": 3.3,
+                                  "waves.components": 120, "waves.tp": 10.0}),
+}
+
+
+@pytest.fixture(scope="module")
+def wave_builds(tmp_path_factory):
+    """The WAVE_SCENES, compiled flavour: {name: folder}."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    out = {}
+    for name, (bem, bodies, waves, method, _) in WAVE_SCENES.items():
+        tmp = tmp_path_factory.mktemp(name)
+        scene = load_scene(wave_scene(tmp, Path(__file__).parent / "data" / "bem" / bem, bodies, waves, method))
+        out[name] = build_scene(scene, tmp / "fmus", log=lambda *_: None, runtime="c")
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(WAVE_SCENES))
+def test_wave_scene_compiled_equals_python(name, wave_builds, tmp_path):
+    """Wave excitation (regular; JONSWAP with spreading), BEM hydrostatics and radiation memory,
+    bodies away from the origin, the sea state changed through the waves.* parameters at
+    initialization (a new draw of the components in both flavours): every output of the load
+    FMUs compiled = Python to 1e-10 of its range over 1000 steps (their dynamics partners,
+    which hold no wave kernel, are held so on the other scenes)."""
+    params = WAVE_SCENES[name][-1]
+    assert assert_equal_flavours(wave_builds[name], tmp_path, params=params, loads_only=True) <= 1e-10
+
+
+def random_wave_scene(seed, tmp):
+    """The BEM pair (10 m either side of the origin) and a random sea state."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform
+    spectrum = ["regular", "jonswap", "pierson_moskowitz"][seed % 3]
+    knobs = (f"height = {u(0.5, 3):.4g}\nperiod = {u(5, 12):.4g}\nphase = {u(-180, 180):.4g}" if spectrum == "regular"
+             else f"hs = {u(1, 5):.4g}\ntp = {u(7, 12):.4g}\nspreading = {u(0, 10):.3g}\ncomponents = "
+                  f"{int(u(20, 150))}\nseed = {int(u(0, 2 ** 40))}" + ("\ngamma = %.3g" % u(1, 5) if spectrum == "jonswap" else ""))
+    waves = f'spectrum = "{spectrum}"\ndirection = {u(0, 360):.4g}\nramp = {u(0, 20):.3g}\n{knobs}'
+    return wave_scene(tmp, Path(__file__).parent / "data" / "bem" / "wave_pair.nc", {"cyl1": -10.0, "cyl2": 10.0}, waves)
+
+
+@pytest.mark.parametrize("seed", [3, 5])
+def test_random_wave_scene_compiled_equals_python(seed, tmp_path):
+    """Randomised wave scenes (regular, Pierson-Moskowitz; JONSWAP is the named irregular scene):
+    the load FMUs compiled = Python to 1e-10 of each output's range."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    folder = build_scene(load_scene(random_wave_scene(seed, tmp_path)), tmp_path / "fmus", log=lambda *_: None,
+                         runtime="c")
+    assert assert_equal_flavours(folder, tmp_path, seed=seed, loads_only=True) <= 1e-10
+
+
+def test_bad_sea_state_fails_initialization_naming_the_knob(wave_builds, tmp_path, capfd):
+    """A waves.* value that is not a usable sea state: fmi2ExitInitializationMode is fmi2Error
+    with a log line naming the parameter, the Python flavour's line."""
+    from fmpy.fmi1 import FMICallException
+    fmu = wave_builds["irregular"] / "waves_cyl1.fmu"
+    unzipped = tmp_path / "u"
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(unzipped)
+    for knob, value, message in (("waves.hs", -1.0, "waves.hs: significant wave height must not be negative"),
+                                 ("waves.tp", 1.5, "waves.tp: Tp = 1.5 s: "),
+                                 ("waves.seed", 1.5, "waves.seed: must be a non-negative integer, found 1.5")):
+        md, s = compiled_slave(fmu, unzipped)
+        refs = {v.name: v.valueReference for v in md.modelVariables}
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.setReal([refs[knob]], [value])
+        capfd.readouterr()
+        with pytest.raises(FMICallException):
+            s.exitInitializationMode()
+        assert message in capfd.readouterr().out
+        s.freeInstance()
+        py, lines = python_slave(unzipped), []
+        py.log = lambda text, *args, **kwargs: lines.append(text)
+        py.setup_experiment(0.0)
+        py.enter_initialization_mode()
+        py.set_real([refs[knob]], [value])
+        py.exit_initialization_mode()
+        assert any(message in line for line in lines), lines

@@ -147,6 +147,14 @@ def test_direction_interpolation_and_wrap():
         both = TransferFunction(pair.omega, np.append(pair.directions, 360.0), np.concatenate((x, x[:, :1]), axis=1),
                                 position=tf.position)
         np.testing.assert_allclose(both.at(pair.omega, np.full(pair.omega.size, 350.0)), a)
+        # directions round the circle that do not start at 0°: 5° lies between 335° and 15°
+        # (the wrap), not on the extension of 15° … 45°
+        # (the same values turned by 15°, referred to the origin: no phase shift to turn)
+        at0 = TransferFunction(pair.omega, pair.directions, x)
+        turned = TransferFunction(pair.omega, pair.directions + 15.0, x)
+        assert turned.closed
+        np.testing.assert_allclose(turned.at(pair.omega, np.full(pair.omega.size, 5.0)),
+                                   at0.at(pair.omega, np.full(pair.omega.size, 350.0)), rtol=1e-12, atol=0)
 
 
 def test_jonswap_and_pm_spectra():

@@ -30,15 +30,12 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # the FMU's C sources, relative to the package (and to the FMU's sources/ folder)
 SOURCES = ["fmi/fmu.c", "fmi/models.c", "physics/kinematics.c", "physics/current.c", "physics/viscous_drag.c",
            "physics/current_polar.c", "physics/lumped.c", "physics/joint.c", "physics/memory.c", "physics/waves.c",
-           "physics/rigid.c"]
+           "physics/hydrostatics.c", "physics/rigid.c"]
 HEADERS = ["fmi/fmu.h", "physics/kernels.h"]
 KINDS = {description.LoadFMU: 0, description.ConnectorFMU: 1, description.DynamicsFMU: 2}
 CAUSALITY = {"parameter": "p", "calculatedParameter": "c", "input": "i", "output": "o"}
 WIN64_CC = "x86_64-w64-mingw32-gcc"
 FLAGS = ["-O2", "-shared", "-std=c99", "-s"]
-# physics/waves.c and the 'waves' record are written against the wave work in progress; a
-# compiled build refuses waves until tests/test_compiled.py holds them against the Python flavour
-WAVES_HELD = False
 
 
 def fmi_headers() -> Path:
@@ -79,16 +76,22 @@ def _inputs(slave):
     return ("inputs", np.r_[tuple(slave.inputs)].tolist() if slave.inputs else [])
 
 
+# the sea-state knobs in the order of the 'waves' record (models.c reads them in this order)
+SEA_KNOBS = ("height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp")
+SPECTRA = {"regular": 0, "jonswap": 1, "pierson_moskowitz": 2}
+
+
 def _waves(slave):
-    """The waves' records: the sea state the waves.* parameters (and g) hold at build time,
-    drawn and interpolated by the Python kernel (its random draw stays in Python), and those
-    values, which the compiled FMU then holds fixed."""
-    slave._start_waves()
-    wave, name = slave.wave, slave.wave_cfg.name
+    """The waves' records: 'waves' [force, elevation and g value references, spectrum, depth,
+    (value reference or -1, scene value) per SEA_KNOBS] and 'transfer' (the body's transfer
+    function, physics/waves.c draws the components from the waves.* parameters at initialization)."""
+    cfg, name = slave.wave_cfg, slave.wave_cfg.name
     vr = {v.name: k for k, v in slave.vars.items()}
-    fixed = [(r, slave.values[r]) for r in list(slave.wave_knobs.values()) + [slave.g]]
-    return [("waves", [vr[f"{name}.force[1]"], vr[f"{name}.elevation"]] + wave.c_params()),
-            ("waves_fixed", [float(x) for pair in fixed for x in pair])]
+    sea = cfg.sea_state()
+    knobs = [x for k in SEA_KNOBS for x in (slave.wave_knobs.get(k, -1), float(getattr(sea, k)))]
+    return [("waves", [vr[f"{name}.force[1]"], vr[f"{name}.elevation"], slave.g, SPECTRA[cfg.spectrum],
+                       float(sea.depth)] + knobs),
+            ("transfer", cfg.transfer(float(slave.values[slave.g]), sea.depth).c_params(cfg.window))]
 
 
 def records(slave, desc) -> list[tuple[str, list[float]]]:
@@ -96,9 +99,6 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     recs = [("kind", [KINDS[type(desc)]]), ("start", slave.values.tolist())]
     if isinstance(desc, description.LoadFMU):
         if getattr(desc, "waves", None) is not None:
-            if not WAVES_HELD:   # until a test holds physics/waves.c against the Python flavour
-                raise InputError(desc.description, None, "waves", "the waves have no compiled kernel yet: build "
-                                 "this scene with runtime = \"python\" ([build] runtime, or --runtime python)")
             recs += _waves(slave)
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave), _inputs(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]

@@ -18,6 +18,9 @@ int hf_rigid_steps(const double *model, const double *table, int steps, const do
 
 static int ivr(double x) { return (int)x; }
 
+enum { SEA_KNOBS = 11 };   /* cbuild.SEA_KNOBS: height, period, phase, hs, tp, gamma, direction, spreading,
+                              components, seed, ramp */
+
 static int *int_list(const double *v, int n) {
     int *out = malloc(sizeof(int) * (n + 1));
     if (out)
@@ -156,7 +159,7 @@ static int memory_load(Memory *m, const double *from, size_t n) {
 
 /* -- load FMU (LoadSlave) --------------------------------------------------------------- */
 
-enum { DRAG = 1, POLAR = 2, LUMPED = 3 };
+enum { DRAG = 1, POLAR = 2, LUMPED = 3, HYDROSTATICS = 4 };
 
 typedef struct {
     int kind, out;
@@ -173,10 +176,9 @@ typedef struct {
     Side motion;
     int explicit_, total, effects_done;
     EnvRefs env;
-    const double *waves;                   /* waves.c's parameters (NULL: no waves) */
+    const double *waves, *transfer;        /* the 'waves' and 'transfer' records (NULL: no waves) */
+    double *wave;                          /* waves.c's per-step parameters (NULL: not drawn yet) */
     int wave_force, wave_elevation;
-    const double *fixed;                   /* [vr, build value] pairs the waves were drawn with */
-    int nfixed;
     int *inputs, ninputs;
     Effect *effects;
     int neffects;
@@ -189,7 +191,7 @@ static void load_release(Instance *inst) {
     if (!L) return;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) memory_free(&L->couplings[k].memory);
-    free(L->inputs), free(L->effects), free(L->couplings), free(L);
+    free(L->inputs), free(L->effects), free(L->couplings), free(L->wave), free(L);
     inst->data = NULL;
 }
 
@@ -215,19 +217,20 @@ static int load_setup(Instance *inst) {
     for (int k = 0; k < inst->nrec; k++) {   /* effects and couplings in the slave's order */
         const Record *e = &inst->rec[k];
         int kind = strcmp(e->tag, "drag") == 0 ? DRAG : strcmp(e->tag, "polar") == 0 ? POLAR
-                 : strcmp(e->tag, "lumped") == 0 ? LUMPED : 0;
+                 : strcmp(e->tag, "lumped") == 0 ? LUMPED : strcmp(e->tag, "hydrostatics") == 0 ? HYDROSTATICS : 0;
         if (kind) {
-            static const int sizes[] = {0, 38, -1, 13};
+            static const int sizes[] = {0, 38, -1, 13, 44};
             if (e->n < 2 || (sizes[kind] > 0 && e->n != sizes[kind]) ||
                 (kind == POLAR && e->n != 1 + 5 + (ivr(e->v[1]) + 2) * 4 + (ivr(e->v[1]) + 1) * 3))
                 goto bad;
             L->effects[L->neffects++] = (Effect){kind, ivr(e->v[0]), e->v + 1};
         } else if (strcmp(e->tag, "waves") == 0) {
-            if (e->n < 4 || e->n != 4 + ivr(e->v[2]) * 15) goto bad;
-            L->wave_force = ivr(e->v[0]), L->wave_elevation = ivr(e->v[1]), L->waves = e->v + 2;
-        } else if (strcmp(e->tag, "waves_fixed") == 0) {
-            if (e->n % 2) goto bad;
-            L->fixed = e->v, L->nfixed = e->n / 2;
+            if (e->n != 5 + 2 * SEA_KNOBS) goto bad;
+            L->wave_force = ivr(e->v[0]), L->wave_elevation = ivr(e->v[1]), L->waves = e->v;
+        } else if (strcmp(e->tag, "transfer") == 0) {
+            int nw = e->n > 7 ? ivr(e->v[5]) : 0, nb = e->n > 7 ? ivr(e->v[6]) : 0;
+            if (nw < 1 || nb < 1 || e->n != 7 + nw + nb + 12 * nw * nb) goto bad;
+            L->transfer = e->v;
         } else if (strcmp(e->tag, "coupling") == 0) {
             if (e->n != 3 + 36) goto bad;
             Coupling *c = &L->couplings[L->ncouplings++];
@@ -239,21 +242,31 @@ static int load_setup(Instance *inst) {
             if (memory_init(m)) goto bad;
         }
     }
+    if (!L->waves != !L->transfer) goto bad;
     return 0;
 bad:
     hf_fail(inst, "model.bin: the load model's records are incomplete or of the wrong size");
     return -1;
 }
 
+/* the wave kernel of the sea state the waves.* parameters (and g) hold now (LoadSlave._start_waves);
+ * -1: a knob that is not a usable sea state, logged naming it */
+static int draw_waves(Instance *inst, Load *L) {
+    const double *w = L->waves, *v = inst->values;
+    double knob[SEA_KNOBS];
+    for (int k = 0; k < SEA_KNOBS; k++) knob[k] = w[5 + 2 * k] >= 0 ? v[ivr(w[5 + 2 * k])] : w[6 + 2 * k];
+    HfSea sea = {ivr(w[3]), knob[0], knob[1], knob[2], knob[3], knob[4], knob[5], knob[6], knob[7], knob[8], knob[9],
+                 knob[10], w[4]};
+    char field[16] = "", message[400] = "";
+    free(L->wave);
+    L->wave = hf_wave_build(&sea, L->transfer, v[ivr(w[2])], field, message, sizeof message);
+    if (!L->wave) hf_fail(inst, "waves.%s: %s", field, message);
+    return L->wave ? 0 : -1;
+}
+
 static void load_start(Instance *inst) {   /* fresh memories (LoadSlave.start_physics) */
     Load *L = inst->data;
-    for (int k = 0; k < L->nfixed; k++) {   /* the sea state is the build's */
-        int vr = ivr(L->fixed[2 * k]);
-        if (inst->values[vr] != L->fixed[2 * k + 1])
-            hf_fail(inst, "%s = %g: the compiled flavour draws its waves at build time (%s = %g there); rebuild "
-                    "the scene with the new value, or use the Python flavour", inst->names[vr], inst->values[vr],
-                    inst->names[vr], L->fixed[2 * k + 1]);
-    }
+    if (L->waves && draw_waves(inst, L)) return;
     for (int k = 0; k < L->ncouplings; k++) {
         Memory *m = &L->couplings[k].memory;
         if (!m->kind) continue;
@@ -280,7 +293,9 @@ static void load_evaluate(Instance *inst) {
     const HfEnv *env = env_now(inst, &L->env);
     for (int k = 0; k < L->neffects && inputs_set; k++) {   /* BodyLoads.effect_loads */
         const Effect *e = &L->effects[k];
-        if (e->kind == DRAG) {
+        if (e->kind == HYDROSTATICS) {
+            hf_hydrostatics(e->params, &m, out);
+        } else if (e->kind == DRAG) {
             hf_viscous_drag(e->params + 1, e->params[0] != 0.0, &m, env, out);
         } else if (e->kind == POLAR) {
             hf_current_polar(e->params, &m, env, out);
@@ -310,7 +325,11 @@ static void load_evaluate(Instance *inst) {
     }
     if (L->waves && inst->running) {   /* a function of time only: the current communication point */
         double w[7];
-        hf_waves(L->waves, inst->has_next ? inst->next_time : 0.0, w);
+        if (!L->wave && draw_waves(inst, L)) {   /* (a state restored into an instance not started) */
+            hf_set_error(inst, "the waves.* parameters are not a usable sea state");
+            return;
+        }
+        hf_waves(L->wave, inst->has_next ? inst->next_time : 0.0, w);
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }

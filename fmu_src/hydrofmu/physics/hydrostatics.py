@@ -45,3 +45,9 @@ class Hydrostatics:
 
     def load(self, motion, env):
         return -self.stiffness.dot(self.deviation(motion))
+
+    C_TAG = "hydrostatics"   # its record in a compiled FMU (hydrostatics.c)
+
+    def c_params(self):
+        """hydrostatics.c's parameters: [C (36, row-major), position0 (3), yaw0, vertical0 (3)]."""
+        return self.stiffness.ravel().tolist() + self.position0.tolist() + [self.yaw0] + self.vertical0.tolist()

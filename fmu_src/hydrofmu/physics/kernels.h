@@ -51,8 +51,23 @@ void hf_viscous_drag(const double *matrix, int relative, const HfMotion *m, cons
 /* current_polar.c: params [n, xc, yc, zc, surfc, angles (n+2), coef ((n+2)*3), slope ((n+1)*3)] */
 void hf_current_polar(const double *params, const HfMotion *m, const HfEnv *env, double *out);
 
-/* waves.c: params [n, ramp length, omega (n), table (2n x 7)]; out: [F (6), elevation] */
+/* waves.c: a sea state (physics.waves.SeaState; spectrum 0 regular, 1 jonswap, 2 pierson_moskowitz) */
+typedef struct {
+    int spectrum;
+    double height, period, phase, hs, tp, gamma, direction, spreading, components, seed, ramp, depth;
+} HfSea;
+/* 0, or -1 with the bad knob's name in field (16 chars) and why in message */
+int hf_sea_check(const HfSea *sea, char *field, char *message, size_t size);
+double hf_wave_number(double omega, double g, double depth);
+/* the per-step parameters [n, ramp length, omega (n), table (2n x 7)] (malloc'd; NULL: field and
+ * message say why) of a sea state and a transfer function [window_lo, window_hi, x, y, closed, nw,
+ * nb, omega (nw), directions (nb), re (nw nb 6), im (nw nb 6)] (TransferFunction.c_params) */
+double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *field, char *message, size_t size);
+/* out: [F (6), elevation] at time t */
 void hf_waves(const double *params, double t, double *out);
+
+/* hydrostatics.c: params [C (36, row-major), position0 (3), yaw0, vertical0 (3)]: F = -C delta */
+void hf_hydrostatics(const double *params, const HfMotion *m, double *out);
 
 /* lumped.c: params [offset (3), am, ae, local (0/1), cd (3), added (3)] */
 int hf_lumped_uses_current(const double *params);

@@ -256,6 +256,7 @@ class TransferFunction:
         order = order[keep]
         self.directions = d[order]
         values = np.asarray(values, dtype=complex)[:, order]
+        self.values = values
         self.position = np.asarray(position, dtype=float)[:2]
         self.g, self.depth = g, depth
         if not np.all(np.isfinite(values)):
@@ -271,6 +272,13 @@ class TransferFunction:
         if self.directions.size == 1:
             self.closed = False
 
+    def c_params(self, window):
+        """waves.c's transfer record: [window (2), x, y, closed, nω, nβ, ω, directions, Re X, Im X]
+        (X in this object's order, (nω, nβ, 6) row-major); ``window`` [rad/s] the scene's."""
+        return (list(map(float, window)) + self.position.tolist() + [float(self.closed), self.omega.size,
+                self.directions.size] + self.omega.tolist() + self.directions.tolist()
+                + self.values.real.ravel().tolist() + self.values.imag.ravel().tolist())
+
     @property
     def window(self):
         return float(self.omega[0]), float(self.omega[-1])
@@ -281,6 +289,7 @@ class TransferFunction:
         d = self.directions
         if self.closed:
             ext = np.concatenate((d, [d[0] + 360.0]))
+            beta = np.where(beta < d[0], beta + 360.0, beta)   # below the first: across the wrap from the last
             j = np.clip(np.searchsorted(ext, beta, side="right") - 1, 0, d.size - 1)
             frac = (beta - ext[j]) / (ext[j + 1] - ext[j])
             return j, (j + 1) % d.size, frac
@@ -339,10 +348,6 @@ class WaveLoad:
         self.table = np.vstack((table.real, -table.imag))
         self.ramp = float(ramp_length)
         self._trig = np.empty(2 * w.size)
-
-    def c_params(self):
-        """waves.c's parameters: [N, ramp length, ω (N), table (2N × 7, row-major)]."""
-        return [float(self.omega.size), self.ramp] + self.omega.tolist() + self.table.ravel().tolist()
 
     def __call__(self, t):
         """(7,) [Fx, Fy, Fz, Mx, My, Mz, η] at time t."""
