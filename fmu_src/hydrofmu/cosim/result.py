@@ -189,7 +189,8 @@ class Result:
         if self.manifest is None:
             raise ValueError("this Result has no manifest, which the plot needs (which FMU is which body's "
                              "load, joint or dynamics): read the CSV with read_csv(path, manifest=BUILT_FOLDER)")
-        path = Path(path)
+        from ..writable import check_plot
+        path = check_plot(path)
         if not path.parent.is_dir():
             raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
         plot(self, self.manifest, path)
