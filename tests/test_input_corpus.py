@@ -110,3 +110,168 @@ def test_batch_output_given_twice_is_refused(tmp_path):
     cases.write_text(BASE.replace('"barge.force[1]"]', '"barge.force[1]", "barge.force[1]"]'))
     with pytest.raises(InputError, match=r"outputs: 'barge.force\[1\]' given twice"):
         load_cases(cases)
+
+
+# --- names that become FMU files, instances and variables never meet ----------------------
+
+from hydrofmu.scene import load_scene
+
+HULL = """
+[bodies.{name}]
+mass = 1.0e5
+inertia = [1.0e6, 1.0e6, 1.0e6]
+"""
+DRAG = """
+[[bodies.{body}.effects]]
+type = "aqwa_viscous_drag"
+name = "{name}"
+matrix = [1.0e3, 1.0e3, 1.0e3, 1.0, 1.0, 1.0]
+"""
+
+
+def scene_error(tmp_path, text):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    with pytest.raises(InputError) as err:
+        load_scene(path)
+    return err.value
+
+
+def test_bodies_differing_only_in_case_are_refused(tmp_path):
+    """Barge.fmu and barge.fmu: one file on Windows and macOS."""
+    err = scene_error(tmp_path, HULL.format(name="barge") + HULL.format(name="Barge"))
+    assert err.field == "bodies.Barge" and "differs from bodies.barge only in case" in err.message
+
+
+def test_a_body_named_earth_is_refused(tmp_path):
+    """b = "earth" is a joint's fixed side: a body of that name made it mean two things."""
+    err = scene_error(tmp_path, HULL.format(name="earth"))
+    assert err.field == "bodies.earth" and "joint's fixed side" in err.message
+
+
+def test_effect_named_like_a_joint_or_total_is_refused(tmp_path):
+    joint = ('[joints.hitch]\na = "barge"\na_point = [1.0, 0.0, 0.0]\nam = 1.0\nae = 0.0\n'
+             'icoo = "GLOBAL"\ncd = [0.0, 0.0, 0.0]\nadded_mass = [0.0, 0.0, 0.0]\ncodes = [0, 0, 0]\n')
+    err = scene_error(tmp_path, HULL.format(name="barge") + DRAG.format(body="barge", name="hitch") + joint)
+    assert err.field == "bodies.barge.effects[0].name" and "also joint hitch" in err.message
+    err = scene_error(tmp_path, HULL.format(name="barge") + DRAG.format(body="barge", name="total"))
+    assert err.field == "bodies.barge.effects[0].name" and "two loads total.force" in err.message
+
+
+def test_effect_named_like_a_coupling_is_refused(tmp_path):
+    """Before: a load FMU with two SELFA.force variable groups, built without a word."""
+    text = (MODELS / "side_by_side.toml").read_text().replace('symmetry = "xz"', 'symmetry = "xz"\nname = "SELFA"', 1)
+    shutil.copytree(MODELS / "decks", tmp_path / "decks")
+    err = scene_error(tmp_path, text)
+    assert err.field == "bodies.barge_a.effects[0].name" and "also coupling SELFA" in err.message
+
+
+def test_inline_polar_table_problem_names_the_table_key(tmp_path):
+    polar = ('\n[[bodies.barge.effects]]\ntype = "deeplines_current_polar"\npoint = [0.0, 0.0, 0.0]\n'
+             'surface = 1.0\ntable = [[0.0, 1.0, 0.0, 0.0], [90.0, 0.0, 1.0, 0.0], [45.0, 1.0, 1.0, 0.0]]\n')
+    err = scene_error(tmp_path, HULL.format(name="barge") + polar)
+    assert err.field == "bodies.barge.effects[0].table" and err.message.startswith("ANGC: ")
+
+
+# --- BEM datasets: scalars that would pass every later comparison -------------------------
+
+@pytest.mark.parametrize("name, value, said", [
+    ("rho", float("nan"), "rho: must be a positive finite number, found nan"),
+    ("rho", 0.0, "rho: must be a positive finite number, found 0"),
+    ("g", float("nan"), "g: must be a positive finite number"),
+    ("water_depth", -10.0, "water_depth: must be positive (inf: deep water), found -10"),
+])
+def test_bem_scalars_must_be_physical(tmp_path, name, value, said):
+    xr = pytest.importorskip("xarray")
+    from hydrofmu.decks.bem import read_bem
+    path = tmp_path / "r.nc"
+    xr.load_dataset(BEM).assign_coords({name: value}).to_netcdf(path)
+    with pytest.raises(InputError) as err:
+        read_bem(path)
+    assert str(path) in str(err.value) and said in str(err.value)
+
+
+def test_bem_dataset_with_only_infinite_frequency_is_exit_2(tmp_path, capsys):
+    """Before: exit 3 (a max over an empty frequency grid)."""
+    xr = pytest.importorskip("xarray")
+    path = tmp_path / "r.nc"
+    xr.load_dataset(BEM).isel(omega=[-1]).to_netcdf(path)
+    line = refused(capsys, ["bem2simo", path, "-o", tmp_path / "r.sim"])
+    assert "r.nc: omega: 0 finite frequencies: at least 3 needed" in line
+    assert not (tmp_path / "r.sim").exists()
+
+
+# --- the Python API ------------------------------------------------------------------------
+
+def test_run_parameters_refuse_a_connected_input_and_a_non_number(demo_build):
+    """Before: a connected input's value was overwritten by the master at once (the run went
+    on without it), a string was passed on, a NaN ended as a run failure at t = 0."""
+    import hydrofmu
+    with pytest.raises(InputError, match=r"parameters: barge.position\[1\] is an input connected to "
+                                         r"barge_dynamics.position\[1\]"):
+        hydrofmu.run(demo_build, stop=0.2, parameters={"barge.position[1]": 1.0})
+    for value in ("1000", float("nan"), True):
+        with pytest.raises(InputError, match=r"parameters: barge.rho = .*: expected a finite number"):
+            hydrofmu.run(demo_build, stop=0.2, parameters={"barge.rho": value})
+
+
+def test_result_to_csv_on_a_folder_and_vector_of_zero(tmp_path):
+    from hydrofmu.cosim.result import Result
+    import numpy as np
+    r = Result(np.array([0.0, 0.1]), ["a.b[1]"], np.zeros((2, 1)), "jacobi", 0.1)
+    with pytest.raises(InputError, match="output file: is a folder, not a file"):
+        r.to_csv(tmp_path)
+    with pytest.raises(ValueError, match="whole number ≥ 1, found 0"):
+        r.vector("a", "b", 0)
+    assert r.vector("a", "b").shape == (2, 1)
+
+
+# --- wave excitation datasets ---------------------------------------------------------------
+
+WAVE = ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc"
+
+
+@pytest.mark.parametrize("edit, field, said", [
+    (lambda d: d.assign_coords(wave_direction=__import__("numpy").degrees(d.wave_direction)), "wave_direction",
+     "Capytaine gives directions in radians"),
+    (lambda d: d.assign_coords(wave_direction=list(d.wave_direction.values[:-1]) + [d.wave_direction.values[0]]),
+     "wave_direction", "a direction given twice"),
+    (lambda d: d.sel(complex="re", drop=True), "excitation_force", "the phase is missing"),
+    (lambda d: d.assign_coords(g=0.0), "g", "must be a positive finite number, found 0"),
+])
+def test_wave_excitation_dataset_slips(tmp_path, edit, field, said):
+    """Before: directions in degrees read as radians (×57), a heading twice, the real part
+    alone (no phase) and g = 0 were all read without a word."""
+    xr = pytest.importorskip("xarray")
+    from hydrofmu.decks.bem_waves import read_excitation
+    path = tmp_path / "w.nc"
+    edit(xr.load_dataset(WAVE)).to_netcdf(path)
+    with pytest.raises(InputError) as err:
+        read_excitation(path)
+    assert err.value.path == str(path) and err.value.field == field and said in err.value.message
+
+
+@pytest.mark.parametrize("options, said", [
+    (["--dofs", "Surge", "Surge"], "cylinders.nc: dofs: 'Surge' given twice"),
+    (["--ulen", "3"], "cylinders.nc: ulen: applies to a nondimensional WAMIT .1 file only"),
+    (["--rho", "1000"], "command line: --rho: applies to a nondimensional WAMIT .1 file only"),
+    (["--symmetry-tolerance", "1e9"], "symmetry_tolerance: 1e+09 would accept any matrix"),
+])
+def test_bem2simo_options_that_would_change_nothing_or_defeat_a_check(tmp_path, capsys, options, said):
+    """Before: each ran to exit 0 (a dof twice, WAMIT's scale options on a dataset ignored,
+    an A∞ symmetry check that accepts anything)."""
+    line = refused(capsys, ["bem2simo", BEM, "-o", tmp_path / "c.sim", *options])
+    assert said in line and not (tmp_path / "c.sim").exists()
+
+
+# --- numbers as Fortran reads them -----------------------------------------------------------
+
+def test_deck_numbers_are_fortran_numbers_not_python_ones():
+    """Python's float() reads '20_000' as 20000 and '１２' as 12: no deck writes them, so a
+    deck value is refused unless Fortran would read it (D exponents, '.5', '2.' are fine)."""
+    from hydrofmu.decks.lines import Line, fields, fortran_float
+    assert [fortran_float(w) for w in ("12", "-1.5", ".5", "2.", "+1.5E3", "2.5D+03", "1d-2")] == \
+        [12.0, -1.5, 0.5, 2.0, 1500.0, 2500.0, 0.01]
+    for word in ("20_000", "0x10", "１２", "1.5E", "--1", "1e5.0"):
+        with pytest.raises(InputError, match=f"AM: expected a number, found '{word}'"):
+            fields(Line("deck.inp", 7, f"{word} 2.5"), ["AM", "AE"])

@@ -211,6 +211,10 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
                           ("--symmetry-tolerance", symmetry_tolerance)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, option, f"must be a positive finite number, found {value:g}")
+    if Path(result).suffix != ".1" and rho is not None:
+        raise InputError("command line", None, "--rho", "applies to a nondimensional WAMIT .1 file only: a "
+                                                         "Capytaine dataset carries its own rho")
+    rho = 1025.0 if rho is None else rho
     check_outputs(files=(out,), plots=(png,), inputs=(result,))
     data = read_bem(result, ulen=ulen, rho=rho)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
@@ -417,7 +421,7 @@ def make_parser():
     m.add_argument("result", type=Path, help="Capytaine dataset (.nc) or WAMIT .1 file")
     m.add_argument("-o", "--out", required=True, type=Path, help="SIMO deck to write")
     m.add_argument("--ulen", type=float, help="WAMIT: the length ULEN [m] of the nondimensional file")
-    m.add_argument("--rho", type=float, default=1025.0, help="WAMIT: density [kg/m3] (default 1025)")
+    m.add_argument("--rho", type=float, help="WAMIT: density [kg/m3] (default 1025)")
     m.add_argument("--dofs", nargs="+", help="dofs to keep, e.g. Surge Heave Pitch (default: all in the file)")
     m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
     m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")

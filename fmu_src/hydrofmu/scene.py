@@ -303,7 +303,11 @@ def _deeplines_current_polar(problems, table, where):
     try:
         angles, cx, cy, cmz = expand_polar(data, symmetry)
     except InputError as exc:
-        problems.add(f"{where}.symmetry", str(exc))
+        if "deck" in table:
+            problems.add(f"{where}.symmetry", str(exc))   # names the deck's file and line
+        else:   # an inline table: the key at fault, the column in the message
+            key = "symmetry" if "symmetry" in exc.message else "table"
+            problems.add(f"{where}.{key}", f"{exc.field}: {exc.message}")
         return None
     return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
             "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
@@ -840,6 +844,7 @@ def _load_scene(path, overrides=None):
     speed, direction, profile = _current(p, env)
     sea = _waves(p, doc["waves"]) if "waves" in doc else None
     _wave_effects(p, bodies, sea, rho, g)
+    _check_names(p, bodies, joints, couplings)
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
@@ -847,6 +852,32 @@ def _load_scene(path, overrides=None):
     )
     p.raise_if_any()
     return scene
+
+
+def _check_names(problems, bodies, joints, couplings):
+    """Names that become FMU files, instances and variables must never meet: bodies and
+    joints name FMU files (``<scene>_<name>.fmu``), compared ignoring case (a Windows or macOS
+    folder holds one of ``Barge.fmu`` and ``barge.fmu``); ``earth`` is a joint's side B, not
+    a body; on one body, an effect's loads ``<name>.force`` must not meet a coupling's or a
+    joint's of the same name (the load FMU and the results would hold two ``X.force``), nor
+    ``total`` (the results' sum of every load)."""
+    seen = {}
+    for key, name in [(f"bodies.{b}", b) for b in bodies] + [(f"joints.{j}", j) for j in joints]:
+        if name == "earth":
+            problems.add(key, "'earth' is a joint's fixed side (b = \"earth\"), not a body name: rename the body")
+        other = seen.setdefault(name.lower(), key)
+        if other != key and other.split(".", 1)[1] != name:
+            problems.add(key, f"{name!r} differs from {other} only in case: FMU files are named by it, and a "
+                              "Windows or macOS folder keeps one of the two")
+    for bname, body in bodies.items():
+        taken = {c.name: f"coupling {c.name}" for c in couplings if bname in (c.a, c.b)}
+        taken.update({j.name: f"joint {j.name}" for j in joints.values() if bname in (j.a, j.b)})
+        taken["total"] = "the sum of the body's loads in the results"
+        for i, effect in enumerate(body.effects):
+            if effect.name in taken:
+                problems.add(f"bodies.{bname}.effects[{i}].name",
+                             f"effect name {effect.name!r} is also {taken[effect.name]} on body {bname!r}: "
+                             f"two loads {effect.name}.force; rename the effect")
 
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")

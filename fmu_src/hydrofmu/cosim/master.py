@@ -14,6 +14,8 @@ Initialisation resolves the feedthrough: connections are transferred twice insid
 initialization mode, so at t = 0 every load output reflects the initial motion.
 """
 import ctypes
+import math
+import numbers
 import sys
 import time as clock
 from pathlib import Path
@@ -393,9 +395,20 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                                                                               system.manifest.get("source", "run"),
                                                                               "run.interval")))
         if own:
+            # a connected input is set by the master at every step: a value given for it would be lost
+            connected = {f"{dst}.{dvar}": f"{src}.{svar}" for src, svar, dst, dvar in system.manifest["connections"]}
+            for key in system.parameters:
+                if key in connected:
+                    raise InputError("run", None, "parameters", f"{key} is an input connected to {connected[key]}: "
+                                                                "the master sets it at every step, a value given "
+                                                                "here would be lost")
             check_names(system.parameters, [f"{name}.{v}" for name, inst in system.instances.items()
-                                            for v, c in inst.causality.items() if c in ("parameter", "input")],
-                        "run", "parameters", "parameter or input")
+                                            for v, c in inst.causality.items()
+                                            if c == "parameter" or (c == "input" and f"{name}.{v}" not in connected)],
+                        "run", "parameters", "parameter or unconnected input")
+            for key, value in system.parameters.items():
+                if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+                    raise InputError("run", None, "parameters", f"{key} = {value!r}: expected a finite number")
         settings = run_settings(system.manifest, step, algorithm, stop)
         rows = Recorder(n, step, len(record), thin, sink)
         if sink is not None:
