@@ -275,3 +275,49 @@ def test_deck_numbers_are_fortran_numbers_not_python_ones():
     for word in ("20_000", "0x10", "１２", "1.5E", "--1", "1e5.0"):
         with pytest.raises(InputError, match=f"AM: expected a number, found '{word}'"):
             fields(Line("deck.inp", 7, f"{word} 2.5"), ["AM", "AE"])
+
+
+# --- a build replaces only a build ----------------------------------------------------------
+
+def test_build_never_replaces_a_folder_that_is_not_a_build(barge, capsys):
+    """Before: a scene named like its deck folder, built with -o next to it, had that folder
+    (its decks) deleted and replaced by the build, exit 0."""
+    folder = barge.parent
+    barge.write_text(barge.read_text().replace('name = "moored_barge"', 'name = "decks"'))
+    decks = sorted(p.name for p in (folder / "decks").iterdir())
+    for extra in (["--check"], []):
+        line = refused(capsys, ["build", barge, "-o", folder, *extra])
+        assert "decks: output folder: exists and is not a built scene (no manifest.json)" in line
+    assert sorted(p.name for p in (folder / "decks").iterdir()) == decks
+
+
+def test_tune_plot_checked_before_the_search(barge, capsys):
+    """Before: `tune --png x.txt` searched for minutes, then ended in exit 3."""
+    line = refused(capsys, ["tune", barge, "--png", barge.parent / "x.txt"])
+    assert "x.txt: plot file: suffix '.txt'" in line
+    line = refused(capsys, ["tune", barge, "--png", barge.parent / "decks" / "barge_viscous.aqwa"])
+    assert "plot file: suffix '.aqwa'" in line
+
+
+def test_added_mass_outweighing_the_body_is_refused(barge, capsys):
+    """Before: a self-coupling A∞ surge term of −2e7 kg on a 1.28e7 kg barge (a sign slip)
+    built without a word; the total mass matrix is not positive definite."""
+    folder = barge.parent
+    deck = folder / "decks" / "side_by_side.sim"
+    lines = deck.read_text().split("\n")
+    assert lines[14].split()[0] == "1.300000e+06"   # SELFA's AM11
+    lines[14] = lines[14].replace("1.300000e+06", "-2.000000e+07", 1)
+    deck.write_text("\n".join(lines))
+    line = refused(capsys, ["build", "--check", folder / "side_by_side.toml"])
+    assert "side_by_side.toml: bodies.barge_a: mass + added mass is not positive definite" in line
+
+
+def test_attitude_in_degrees_is_said_out_loud(tmp_path):
+    """attitude is in radians: 90 (a quarter turn in degrees) is 90 rad; legal, so a warning
+    naming the key, kept in the scene's warnings for the manifest."""
+    from hydrofmu.errors import InputWarning
+    path = tmp_path / "s.toml"
+    path.write_text(HULL.format(name="barge") + "attitude = [0.0, 0.0, 90.0]\n")
+    with pytest.warns(InputWarning, match=r"bodies.barge.attitude: 90 rad is beyond ±2π .* degrees written"):
+        scene = load_scene(path)
+    assert any("bodies.barge.attitude" in w for w in scene.warnings)

@@ -251,7 +251,9 @@ def tune(args):
     if args.png is None:
         check_folder(png.parent)
         png.parent.mkdir(parents=True, exist_ok=True)
-    check_outputs(files=(png,) + ((args.scene,) if args.write else ()))
+    # --write makes the scene an output; its decks (and the scene, without --write) are inputs
+    check_outputs(files=(args.scene,) if args.write else (), plots=(png,),
+                  inputs=(*scene_files(args.scene), *(() if args.write else (args.scene,))))
     found = run_tune(args.scene, tolerance(args.tolerance), outputs=args.outputs, window=args.window,
                      repeats=args.repeats, png=png, log=lambda s: None)
     for line in found.report():

@@ -725,6 +725,8 @@ def _body(problems, name, table, where):
         problems.add_all(where, admissible.inertia(body.inertia))
     if body.attitude is not None:
         problems.add_all(where, admissible.attitude(body.attitude))
+        if admissible.odd_attitude(body.attitude):
+            problems.warn(f"{where}.attitude", admissible.odd_attitude(body.attitude))
     effects = table.get("effects", [])
     if not isinstance(effects, list):
         problems.add(f"{where}.effects", "expected an array of tables ([[bodies.NAME.effects]])")

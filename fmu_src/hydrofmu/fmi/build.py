@@ -271,6 +271,7 @@ def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None, r
     runtime = runtime_name() if flavour == "python" else None   # None: the compiled flavour
     for line in notes(scene, system):
         log(line)
+    check_target(scene, target)
     if check:
         return None
     if outdir.exists() and not outdir.is_dir():
@@ -285,6 +286,26 @@ def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None, r
         if created is not None and not target.exists():
             shutil.rmtree(created, ignore_errors=True)   # no empty folders left by a failed build
     return target
+
+
+def check_target(scene, target):
+    """A build replaces ``target`` (OUT/<scene name>) whole: refuse when that would delete
+    what is not a build (a folder without manifest.json holding files, e.g. the scene's
+    decks) or the scene's own files (a deck kept inside its build folder)."""
+    from ..api import scene_files
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise InputError(target, None, "output folder", "is a file, where the build's folder goes")
+    if target.is_dir() and any(target.iterdir()) and not (target / "manifest.json").is_file():
+        raise InputError(target, None, "output folder", "exists and is not a built scene (no manifest.json): a "
+                                                        "build replaces it whole and would delete what it holds; "
+                                                        "move it or build elsewhere (-o)")
+    real = target.resolve()
+    for f in [Path(scene.path)] * bool(getattr(scene, "path", None)) + (
+            scene_files(scene.path) if getattr(scene, "path", None) else []):
+        if real in Path(f).resolve().parents:
+            raise InputError(f, None, "output folder", f"lies inside {target}, which the build replaces whole: "
+                                                       "keep the scene's files out of its build folder")
 
 
 def _build_into(scene, outdir, target, system, runtime, shim, log, inputs=None):
