@@ -321,3 +321,13 @@ def test_attitude_in_degrees_is_said_out_loud(tmp_path):
     with pytest.warns(InputWarning, match=r"bodies.barge.attitude: 90 rad is beyond ±2π .* degrees written"):
         scene = load_scene(path)
     assert any("bodies.barge.attitude" in w for w in scene.warnings)
+
+
+def test_coupling_map_key_naming_no_deck_body_is_refused(tmp_path):
+    """Before: `bodies = { BARGEA = "barge_a", BARGE_B = "barge_b" }` mapped nothing with its
+    second key, without a word (the body it meant kept its deck name)."""
+    shutil.copytree(MODELS / "decks", tmp_path / "decks")
+    text = (MODELS / "side_by_side.toml").read_text().replace(
+        'bodies = { BARGEA = "barge_a", BARGEB = "barge_b" }', 'bodies = { BARGEA = "barge_a", BARGE_B = "barge_b" }', 1)
+    err = scene_error(tmp_path, text)
+    assert err.field == "couplings[0].bodies.BARGE_B" and "did you mean 'BARGEB'" in err.message

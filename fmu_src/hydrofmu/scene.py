@@ -543,6 +543,13 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         if name not in decks:
             problems.add(f"{where}.coupling", f"{name!r} is not in {path.name} (it has: {', '.join(decks) or 'none'})")
             continue
+        in_deck = {b for c in decks.values() for b in (c.body_a, c.body_b)}
+        stray = [k for k in mapping if k not in in_deck]
+        if stray:   # a misspelt key maps nothing: the body it meant keeps its deck name
+            problems.add(f"{where}.bodies.{stray[0]}", f"no coupling of {path.name} names a body {stray[0]!r}"
+                                                      f"{did_you_mean(stray[0], sorted(in_deck))} (its bodies: "
+                                                      f"{', '.join(sorted(in_deck))})")
+            continue
         d = decks[name]
         a, b = mapping.get(d.body_a, d.body_a), mapping.get(d.body_b, d.body_b)
         for side, body in (("A", a), ("B", b)):
