@@ -205,14 +205,18 @@ def test_bem_dataset_with_only_infinite_frequency_is_exit_2(tmp_path, capsys):
 
 def test_run_parameters_refuse_a_connected_input_and_a_non_number(demo_build):
     """Before: a connected input's value was overwritten by the master at once (the run went
-    on without it), a string was passed on, a NaN ended as a run failure at t = 0."""
-    import hydrofmu
+    on without it), a string was passed on, a NaN ended as a run failure at t = 0.  The check
+    `run` makes before loading any FMU, on the built folder's manifest."""
+    from hydrofmu.cosim.manifest import read_manifest
+    from hydrofmu.cosim.master import _check_parameters
+    manifest = read_manifest(demo_build)
     with pytest.raises(InputError, match=r"parameters: barge.position\[1\] is an input connected to "
                                          r"barge_dynamics.position\[1\]"):
-        hydrofmu.run(demo_build, stop=0.2, parameters={"barge.position[1]": 1.0})
+        _check_parameters({"barge.position[1]": 1.0}, manifest)
     for value in ("1000", float("nan"), True):
         with pytest.raises(InputError, match=r"parameters: barge.rho = .*: expected a finite number"):
-            hydrofmu.run(demo_build, stop=0.2, parameters={"barge.rho": value})
+            _check_parameters({"barge.rho": value}, manifest)
+    _check_parameters({"barge.rho": 1000.0}, manifest)
 
 
 def test_result_to_csv_on_a_folder_and_vector_of_zero(tmp_path):
