@@ -122,7 +122,7 @@ def test_run_record_and_parameters_names_suggest_the_closest(demo_build):
     with pytest.raises(InputError, match=r"record: unknown 'instance.variable' 'barge.forse\[1\]' "
                                          r"\(did you mean 'barge.force\[1\]'"):
         hydrofmu.run(demo_build, stop=0.2, record=["barge.forse[1]"])
-    with pytest.raises(InputError, match=r"parameters: unknown parameter or input 'barge.rhoo' "
+    with pytest.raises(InputError, match=r"parameters: unknown parameter or unconnected input 'barge.rhoo' "
                                          r"\(did you mean 'barge.rho'"):
         hydrofmu.run(demo_build, stop=0.2, parameters={"barge.rhoo": 1000.0})
 

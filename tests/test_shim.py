@@ -15,6 +15,7 @@ import subprocess
 import sys
 import uuid
 import zipfile
+from pathlib import Path
 from ctypes import byref, c_double, c_void_p
 
 import pytest
@@ -600,3 +601,72 @@ def test_pythonfmu_guard_released_before_exit(fmus):
     out = subprocess.run([sys.executable, "-c", GUARD, str(fmus[1])], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["None", "None"]
+
+
+POOLED_RESTART = """
+import gc, json, os, sys
+from pathlib import Path
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+FMU = sys.argv[1]
+md = read_model_description(FMU)
+unzipped = extract(FMU)
+config = Path(unzipped) / "resources" / "hydrofmu.json"
+text = config.read_text()
+
+def instance():
+    s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, instanceName="barge",
+                  modelIdentifier=md.coSimulation.modelIdentifier)
+    s.instantiate()
+    return s
+
+def step(s):
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    s.doStep(0.0, 0.1)
+    return s.getReal([v.valueReference for v in md.modelVariables if v.name.startswith("force[")])
+
+for _ in range(2):   # the second fmi2FreeInstance pools the instance (its key came back)
+    s = instance()
+    before = step(s)
+    s.freeInstance()
+model = md.coSimulation.modelIdentifier
+refs = sys.getrefcount(getattr(sys.modules[model], model))   # the slave class: one pooled instance
+config.write_text("{")   # the pooled instance's fmi2Reset now builds a slave that cannot start
+try:
+    instance()
+except Exception as exc:
+    print("refused:", exc)
+gc.collect()
+config.write_text(text)
+s = instance()
+after = step(s)
+s.freeInstance()   # pooled again
+gc.collect()
+print("class references", refs, sys.getrefcount(getattr(sys.modules[model], model)))
+print("stepped", [before, after])
+"""
+
+
+def test_slave_that_cannot_start_is_refused_not_a_corrupted_host(demo_build, tmp_path):
+    # pythonfmu 0.7 answers an exception in a slave's constructor by releasing the slave's
+    # class and message list twice (once in its handler, once at fmi2FreeInstance): in a
+    # Python host, a segfault much later.  The instance reused from the shim's pool, whose
+    # description became unreadable, must fail fmi2Instantiate with the reason, and the
+    # process must go on: Python's debug allocator turns any double release into a crash.
+    fmu = next(Path(demo_build).glob("moored_barge_barge.fmu"))
+    script = tmp_path / "restart.py"
+    script.write_text(POOLED_RESTART)
+    env = {**os.environ, "PYTHONMALLOC": "debug"}
+    run = subprocess.run([sys.executable, str(script), str(fmu)], capture_output=True, text=True,
+                         env=env, timeout=120)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "cannot start: JSONDecodeError" in run.stdout + run.stderr
+    assert "refused:" in run.stdout
+    # none released twice (before the fix: 9 -> 8; pythonfmu's fresh fmi2Instantiate of the
+    # recovery keeps one reference for good, in the MRO list it leaks: 9 -> 10 now)
+    before, after = map(int, run.stdout.split("class references", 1)[1].split()[:2])
+    assert after >= before
+    before, after = eval(run.stdout.split("stepped", 1)[1])   # one step of the same instance
+    assert len(after) == 6 and all(math.isfinite(f) for f in after) and after == before

@@ -77,6 +77,16 @@ def odd_direction(degrees):
     return f"direction {degrees:g}° is outside 0…360° (read as {degrees % 360.0:g}°): a typing slip?"
 
 
+def odd_attitude(angles):
+    """Suspicious, not wrong: an attitude angle beyond ±2π rad (degrees written where
+    radians go: 90 for a quarter turn is 90 rad).  Returns the message, or None."""
+    big = [a for a in angles if abs(a) > 2.0 * math.pi]
+    if not big:
+        return None
+    return (f"{big[0]:g} rad is beyond ±2π (read as {math.degrees(big[0]) % 360.0:.4g}°): attitude is in "
+            f"radians; degrees written? ({big[0]:g}° = {math.radians(big[0]):.6g} rad)")
+
+
 def _list(values):
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
 

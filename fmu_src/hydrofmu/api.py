@@ -103,6 +103,17 @@ def _files_named(value, base):
     return []
 
 
+def scene_files(path: str | Path) -> list[Path]:
+    """The existing files a scene file's values name (decks, BEM results, current files),
+    resolved; [] when it cannot be read as TOML."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return []
+    return sorted(set(_files_named(doc, path.resolve().parent)))
+
+
 def inputs_hash(path: str | Path) -> str | None:
     """What a build of the scene file ``path`` depends on, as one hash: the scene's bytes,
     every file its values name (decks, BEM results, current files: any string that is a

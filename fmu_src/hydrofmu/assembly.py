@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import description as d
+from .errors import InputError
 from .physics import joint as conb
 from .physics.kinematics import rotation
 from .physics.loads import BodyLoads, make_effect
@@ -122,6 +123,20 @@ def exported_mass(scene, every_mode=False):
         if s.own and export(scene.bodies[s.source].accel_mode):
             out[s.source] = out[s.source] + s.mass
     return out
+
+
+def check_total_mass(scene, added):
+    """Each body's mass plus the added mass on it (``added``: `exported_mass` in every mode)
+    must be positive definite, or no integrator can move it (e.g. a negative A∞ diagonal
+    larger than the mass): one InputError naming the body."""
+    for name, body in scene.bodies.items():
+        m = rigid_mass(body, added[name])
+        low = np.linalg.eigvalsh(0.5 * (m + m.T)).min()
+        if not low > 0:
+            raise InputError(scene.path, None, f"bodies.{name}",
+                             f"mass + added mass is not positive definite (smallest eigenvalue {low:.4g}): a "
+                             "negative added mass from a coupling deck, effect or joint outweighs the body's "
+                             "own; check the signs and units of the added mass")
 
 
 def dynamics_groups(scene):
@@ -257,7 +272,9 @@ def assemble(scene) -> System:
     loads = [_loads(scene, body, sides, env) for body in scene.bodies.values()]
     joints = [_connector(scene, joint, exported, env) for joint in scene.joints.values()]
     dynamics = [_dynamics(scene, instance, members, exported, sides) for instance, members in groups]
-    indicators = stability_indicators(scene, exported_mass(scene, every_mode=True))
+    every = exported_mass(scene, every_mode=True)
+    check_total_mass(scene, every)
+    indicators = stability_indicators(scene, every)
     return System(loads + joints + dynamics, dyn_of, indicators)
 
 

@@ -49,6 +49,7 @@ from .writable import check_folder
 
 RUN_ALIASES = {"stop": "run.stop", "step": "run.step", "algorithm": "run.algorithm",
                "hs": "waves.hs", "tp": "waves.tp", "seed": "waves.seed", "wave_direction": "waves.direction"}
+ALGORITHMS = ("jacobi", "gauss-seidel")   # the fmpy master's, which runs every case
 # scene keys the FMUs expose: key -> FMU variable name (in every FMU that has it)
 EXPOSED = {"environment.current_speed": "current.speed", "environment.current_direction": "current.direction",
            "environment.rho": "rho", "environment.g": "g",
@@ -152,12 +153,15 @@ def load_cases(source, base=None) -> Batch:
             or not all(isinstance(o, str) and "." in o for o in outputs)):
         p.add("outputs", "expected a non-empty array of 'instance.variable' names")
         outputs = []
+    twice = sorted({o for o in outputs if outputs.count(o) > 1})
+    if twice:
+        p.add("outputs", f"{', '.join(map(repr, twice))} given twice (one column per output)")
     fixed, seen = {}, {}
     for key in ("stop", "step"):
         if key in doc and p.number(doc, key, key, positive=True) is not None:
             fixed[f"run.{key}"] = float(doc[key])
             seen[f"run.{key}"] = f"{key} (top level)"
-    if "algorithm" in doc and p.choice(doc, "algorithm", "algorithm", ("jacobi", "gauss-seidel")):
+    if "algorithm" in doc and p.choice(doc, "algorithm", "algorithm", ALGORITHMS):
         fixed["run.algorithm"] = doc["algorithm"]
         seen["run.algorithm"] = "algorithm (top level)"
     transient = p.number(doc, "transient", "transient", 0.0, nonneg=True)
@@ -171,6 +175,9 @@ def load_cases(source, base=None) -> Batch:
         values = values if isinstance(values, list) else [values]
         if not values:
             p.add(f"matrix.{key}", "expected at least one value")
+        again = next((v for k, v in enumerate(values) if v in values[:k]), None)
+        if again is not None:
+            p.add(f"matrix.{key}", f"value {again!r} given twice (two cases would be one)")
         matrix[key] = values
     extra = doc.get("cases", [])
     if not isinstance(extra, list) or not all(isinstance(c, dict) for c in extra):
@@ -178,6 +185,13 @@ def load_cases(source, base=None) -> Batch:
         extra = []
     # a single case may override a shared knob (its own value), not give one twice itself
     extra = [_knobs(p, c, f"cases[{i}]") for i, c in enumerate(extra)]
+    # the algorithm is one knob wherever it is written: checked the same in every table
+    for where, value in ([("set.run.algorithm", fixed.get("run.algorithm"))]
+                         + [("matrix.run.algorithm", v) for v in matrix.get("run.algorithm", [])]
+                         + [(f"cases[{i}].run.algorithm", c.get("run.algorithm")) for i, c in enumerate(extra)]):
+        if value is not None and value not in ALGORITHMS:
+            p.add(where, f"expected one of {', '.join(map(repr, ALGORITHMS))} (a batch runs on the fmpy master), "
+                         f"found {value!r}")
     batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True)
     built = scene is not None and scene.is_dir()
     for key in batch.keys:
@@ -232,6 +246,7 @@ def check_knobs(batch):
     from .scene import load_scene, override
     if batch.scene.is_dir():
         run = read_manifest(batch.scene)["run"]
+        _check_transient(batch, run)
     else:
         doc = read_toml(batch.scene, "scene")
         first = {k: v for k, v in _first_values(batch).items()
@@ -246,13 +261,25 @@ def check_knobs(batch):
             warnings.simplefilter("ignore", InputWarning)
             if first:
                 _check_scene_keys(batch, first)
-            if not {"run.stop", "run.step"} & set(batch.keys):
+            if not {"run.stop", "run.step"} & set(batch.keys) and not batch.transient:
                 return None
             try:
                 run = load_scene(batch.scene).run
             except InputError:
                 return None   # the scene's own error is every case's
+        _check_transient(batch, run)
     _check_case_steps(batch, run)
+
+
+def _check_transient(batch, run):
+    """The statistics' ``transient`` must leave part of every case's run (t < stop)."""
+    if not batch.transient:
+        return
+    stops = {knobs.get("run.stop", run["stop"]) for knobs in batch.cases()}
+    short = min((s for s in stops if isinstance(s, (int, float)) and not isinstance(s, bool)), default=None)
+    if short is not None and batch.transient >= short:
+        raise InputError(batch.path, None, "transient", f"{batch.transient:g} s leaves nothing of a case that ends "
+                                                        f"at {short:g} s (the statistics keep t ≥ transient)")
 
 
 def _check_scene_keys(batch, first):

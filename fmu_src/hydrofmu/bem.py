@@ -99,13 +99,18 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
                                   or not math.isfinite(value) or value <= 0):
             raise InputError(path, None, name, f"must be a positive finite number, found {value!r}")
+    if symmetry_tol is not None and symmetry_tol >= 1:
+        raise InputError(path, None, "symmetry_tolerance", f"{symmetry_tol:g} would accept any matrix (it is "
+                                                           "relative to the diagonal): use a value below 1, e.g. 0.01")
     for b in bodies:
         if b not in data.bodies:
             raise InputError(path, None, "body", f"{b!r} is not a body of the result (it has: {', '.join(data.bodies)})")
     want = list(DOF_NAMES) if dofs is None else list(dofs)
-    for name in want:
+    for k, name in enumerate(want):
         if name not in DOF_NAMES:
             raise InputError(path, None, "dofs", f"{name!r} is not a dof name ({', '.join(DOF_NAMES)})")
+        if name in want[:k]:
+            raise InputError(path, None, "dofs", f"{name!r} given twice")
     keep = []
     for b in data.bodies:
         if b not in bodies:

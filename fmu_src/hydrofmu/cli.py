@@ -8,7 +8,7 @@ import warnings
 import zipfile
 from pathlib import Path
 
-from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
+from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs, scene_files
 from .cosim.manifest import read_manifest
 from .cosim.master import check_steps, describe
 from .errors import InputError, InputWarning
@@ -62,10 +62,12 @@ def build(paths, outdir=DEFAULT_OUT, log=print, check=False, runtime=None):
 
 
 def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, algorithm=None, out=None,
-              summary=None):
+              summary=None, inputs=()):
     """Bad run arguments as one InputError, before anything is built or written: step and
     stop positive, stop a whole number of steps (``run``: the scene's or the built folder's
-    [run] settings, for what the command line leaves out), every output writable."""
+    [run] settings, for what the command line leaves out), every output writable, the PNG's
+    suffix a plot format, no output twice nor one of the ``inputs`` (the scene file, its
+    decks) or inside the built ``folder``."""
     for key, value in (("step", step), ("stop", stop)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, f"--{key}", f"must be a positive finite number, found {value:g}")
@@ -76,7 +78,7 @@ def check_run(folder=None, csv=None, png=None, step=None, stop=None, run=None, a
         check_steps(stop or run["stop"], step or run["step"], algorithm or run["algorithm"],
                     "command line" if given else run.get("source", folder),
                     {"stop": "--stop", "step": "--step"} if given else {"stop": "run.stop", "step": "run.step"})
-    check_outputs(files=(csv, png, summary), folders=(out,))
+    check_outputs(files=(csv, summary), plots=(png,), folders=(out,), inputs=(*inputs, folder))
 
 
 def _stderr(text):
@@ -84,7 +86,7 @@ def _stderr(text):
 
 
 def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=0.0, log=_stderr, say=print,
-               parquet=None, **kw):
+               parquet=None, inputs=(), **kw):
     """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
     an ECCO run, else fmpy), its settings said once first (``say``); write CSV/PNG and the
     summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
@@ -95,7 +97,8 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
     folder = Path(folder)
-    check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"), summary=summary)
+    check_run(folder, csv, png, kw.get("step"), kw.get("stop"), algorithm=kw.get("algorithm"), summary=summary,
+              inputs=inputs)
     if not (math.isfinite(transient) and transient >= 0):
         raise InputError("command line", None, "--transient", f"must be a finite time ≥ 0 [s], found {transient:g}")
     manifest = read_manifest(folder)
@@ -117,7 +120,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     from .cosim.stream import Sink
     if parquet is None and csv is not None and _has_pyarrow():
         parquet = Path(csv).with_suffix(".parquet")
-    check_outputs(files=(parquet,))
+    check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
     try:
         result = run(folder, sink=Sink(parquet, csv) if parquet or csv else None, **kw)
@@ -215,7 +218,11 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
                           ("--symmetry-tolerance", symmetry_tolerance)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InputError("command line", None, option, f"must be a positive finite number, found {value:g}")
-    check_outputs(files=(out, png))
+    if Path(result).suffix != ".1" and rho is not None:
+        raise InputError("command line", None, "--rho", "applies to a nondimensional WAMIT .1 file only: a "
+                                                         "Capytaine dataset carries its own rho")
+    rho = 1025.0 if rho is None else rho
+    check_outputs(files=(out,), plots=(png,), inputs=(result,))
     data = read_bem(result, ulen=ulen, rho=rho)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
                      SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance, a_inf_from=a_inf)
@@ -251,7 +258,9 @@ def tune(args):
     if args.png is None:
         check_folder(png.parent)
         png.parent.mkdir(parents=True, exist_ok=True)
-    check_outputs(files=(png,) + ((args.scene,) if args.write else ()))
+    # --write makes the scene an output; its decks (and the scene, without --write) are inputs
+    check_outputs(files=(args.scene,) if args.write else (), plots=(png,),
+                  inputs=(*scene_files(args.scene), *(() if args.write else (args.scene,))))
     found = run_tune(args.scene, tolerance(args.tolerance), outputs=args.outputs, window=args.window,
                      repeats=args.repeats, png=png, log=lambda s: None)
     for line in found.report():
@@ -421,7 +430,7 @@ def make_parser():
     m.add_argument("result", type=Path, help="Capytaine dataset (.nc) or WAMIT .1 file")
     m.add_argument("-o", "--out", required=True, type=Path, help="SIMO deck to write")
     m.add_argument("--ulen", type=float, help="WAMIT: the length ULEN [m] of the nondimensional file")
-    m.add_argument("--rho", type=float, default=1025.0, help="WAMIT: density [kg/m3] (default 1025)")
+    m.add_argument("--rho", type=float, help="WAMIT: density [kg/m3] (default 1025)")
     m.add_argument("--dofs", nargs="+", help="dofs to keep, e.g. Surge Heave Pitch (default: all in the file)")
     m.add_argument("--timdel", type=float, help="kernel spacing [s] (default from the highest frequency)")
     m.add_argument("--kernel-length", type=float, help="kernel length [s] (default from the decay of K)")
@@ -472,6 +481,7 @@ def _main(argv):
         return 1 if validate(args.paths) else 0
     elif args.command == "run":
         folder = Path(args.scene)
+        inputs = (folder, *scene_files(folder)) if folder.suffix == ".toml" else ()
         reuse = built_folder(folder, args.out) if folder.suffix == ".toml" else None
         if reuse is not None:
             folder = reuse
@@ -480,14 +490,15 @@ def _main(argv):
             from .scene import load_scene
             scene = load_scene(folder)
             # the default CSV/PNG go into OUT, which the build makes: OUT is checked for them
-            check_run(None, args.csv, args.png, args.step, args.stop,
-                      {**scene.run, "source": str(scene.path)}, args.algorithm, args.out)
+            check_run(Path(args.out) / scene.name, args.csv, args.png, args.step, args.stop,
+                      {**scene.run, "source": str(scene.path)}, args.algorithm, args.out,
+                      inputs=inputs)
             folder = next(iter(build([scene], args.out).values()))
         csv, png = outputs(folder)
         csv, png = args.csv or csv, args.png or png
         extra = {k: v for k, v in (("outputs", args.outputs), ("interval", args.interval)) if v is not None}
         result = run_folder(folder, args.engine, csv, png, folder.with_name(folder.name + ".summary.json"),
-                            args.transient, parquet=args.parquet, stop=args.stop, step=args.step,
+                            args.transient, parquet=args.parquet, inputs=inputs, stop=args.stop, step=args.step,
                             algorithm=args.algorithm, **extra)
         if result.stats is not None:
             print(result.stats)

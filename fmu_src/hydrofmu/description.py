@@ -292,7 +292,7 @@ def from_plain(tp, value):
     if tp is np.ndarray:
         return np.asarray(value, dtype=float)
     if is_dataclass(tp):
-        hints = typing.get_type_hints(tp)
+        hints = _hints(tp)
         return tp(**{f.name: from_plain(hints[f.name], value[f.name]) for f in fields(tp) if f.name in value})
     if origin is list:
         (item,) = typing.get_args(tp)
@@ -300,6 +300,15 @@ def from_plain(tp, value):
     if tp is float:
         return float(value)
     return value
+
+
+def _hints(tp) -> dict:
+    """A dataclass's resolved field types.  The annotations are strings (postponed), evaluated
+    in the class's own module namespace, taken from the class rather than from sys.modules:
+    inside an FMU loaded into a running Python, a build in the same process may have taken
+    this runtime's modules out of sys.modules, and typing.get_type_hints would then see an
+    empty namespace (NameError on 'np')."""
+    return typing.get_type_hints(tp, globalns=tp.__init__.__globals__)
 
 
 def dumps(desc: Description) -> str:

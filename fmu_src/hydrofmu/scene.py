@@ -303,7 +303,11 @@ def _deeplines_current_polar(problems, table, where):
     try:
         angles, cx, cy, cmz = expand_polar(data, symmetry)
     except InputError as exc:
-        problems.add(f"{where}.symmetry", str(exc))
+        if "deck" in table:
+            problems.add(f"{where}.symmetry", str(exc))   # names the deck's file and line
+        else:   # an inline table: the key at fault, the column in the message
+            key = "symmetry" if "symmetry" in exc.message else "table"
+            problems.add(f"{where}.{key}", f"{exc.field}: {exc.message}")
         return None
     return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
             "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
@@ -539,6 +543,13 @@ def _couplings(problems, items, bodies, memory=MEMORY_DEFAULTS, env=None):
         if name not in decks:
             problems.add(f"{where}.coupling", f"{name!r} is not in {path.name} (it has: {', '.join(decks) or 'none'})")
             continue
+        in_deck = {b for c in decks.values() for b in (c.body_a, c.body_b)}
+        stray = [k for k in mapping if k not in in_deck]
+        if stray:   # a misspelt key maps nothing: the body it meant keeps its deck name
+            problems.add(f"{where}.bodies.{stray[0]}", f"no coupling of {path.name} names a body {stray[0]!r}"
+                                                      f"{did_you_mean(stray[0], sorted(in_deck))} (its bodies: "
+                                                      f"{', '.join(sorted(in_deck))})")
+            continue
         d = decks[name]
         a, b = mapping.get(d.body_a, d.body_a), mapping.get(d.body_b, d.body_b)
         for side, body in (("A", a), ("B", b)):
@@ -721,6 +732,8 @@ def _body(problems, name, table, where):
         problems.add_all(where, admissible.inertia(body.inertia))
     if body.attitude is not None:
         problems.add_all(where, admissible.attitude(body.attitude))
+        if admissible.odd_attitude(body.attitude):
+            problems.warn(f"{where}.attitude", admissible.odd_attitude(body.attitude))
     effects = table.get("effects", [])
     if not isinstance(effects, list):
         problems.add(f"{where}.effects", "expected an array of tables ([[bodies.NAME.effects]])")
@@ -840,6 +853,7 @@ def _load_scene(path, overrides=None):
     speed, direction, profile = _current(p, env)
     sea = _waves(p, doc["waves"]) if "waves" in doc else None
     _wave_effects(p, bodies, sea, rho, g)
+    _check_names(p, bodies, joints, couplings)
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
@@ -847,6 +861,32 @@ def _load_scene(path, overrides=None):
     )
     p.raise_if_any()
     return scene
+
+
+def _check_names(problems, bodies, joints, couplings):
+    """Names that become FMU files, instances and variables must never meet: bodies and
+    joints name FMU files (``<scene>_<name>.fmu``), compared ignoring case (a Windows or macOS
+    folder holds one of ``Barge.fmu`` and ``barge.fmu``); ``earth`` is a joint's side B, not
+    a body; on one body, an effect's loads ``<name>.force`` must not meet a coupling's or a
+    joint's of the same name (the load FMU and the results would hold two ``X.force``), nor
+    ``total`` (the results' sum of every load)."""
+    seen = {}
+    for key, name in [(f"bodies.{b}", b) for b in bodies] + [(f"joints.{j}", j) for j in joints]:
+        if name == "earth":
+            problems.add(key, "'earth' is a joint's fixed side (b = \"earth\"), not a body name: rename the body")
+        other = seen.setdefault(name.lower(), key)
+        if other != key and other.split(".", 1)[1] != name:
+            problems.add(key, f"{name!r} differs from {other} only in case: FMU files are named by it, and a "
+                              "Windows or macOS folder keeps one of the two")
+    for bname, body in bodies.items():
+        taken = {c.name: f"coupling {c.name}" for c in couplings if bname in (c.a, c.b)}
+        taken.update({j.name: f"joint {j.name}" for j in joints.values() if bname in (j.a, j.b)})
+        taken["total"] = "the sum of the body's loads in the results"
+        for i, effect in enumerate(body.effects):
+            if effect.name in taken:
+                problems.add(f"bodies.{bname}.effects[{i}].name",
+                             f"effect name {effect.name!r} is also {taken[effect.name]} on body {bname!r}: "
+                             f"two loads {effect.name}.force; rename the effect")
 
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")

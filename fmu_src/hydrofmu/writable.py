@@ -5,6 +5,12 @@ fails after the work is done.  One set of rules for every command and the batch:
   a folder and take a new file (probed by creating and removing one);
 - an output **folder** (``-o``) must be a folder or not exist yet; then its nearest existing
   parent must be a folder that takes a new file (the folder is created when written);
+- a **plot** file's suffix must name a format matplotlib writes (``.png``, ``.pdf``, ``.svg``…):
+  no suffix, or ``.txt``, is refused up front, not after the run;
+- no two outputs of one command may be the same file, and no output may be one of the
+  command's inputs (the scene, its decks, the BEM result) or lie inside an input folder (the
+  built scene folder, which a rebuild replaces whole): an output never overwrites what it is
+  made from;
 - ``keep``: a write that fails after a run (disk full, folder removed meanwhile) goes to a
   fallback folder instead (the current folder, else the system's temporary folder) and the
   caller says where: results are never lost to an output path.
@@ -63,14 +69,53 @@ def check_folder(path, field: str = "output folder") -> Path:
     return path
 
 
-def check_outputs(files=(), folders=()) -> None:
-    """``check_file`` of every file, ``check_folder`` of every folder (None entries skipped)."""
+def check_plot(path, field: str = "plot file") -> Path:
+    """InputError unless ``path`` ends in a format matplotlib writes (the suffix decides it)."""
+    path = Path(path)
+    from matplotlib.backend_bases import FigureCanvasBase
+    formats = sorted(FigureCanvasBase.get_supported_filetypes())
+    if path.suffix[1:].lower() not in formats:
+        found = f"suffix {path.suffix!r}" if path.suffix else "no suffix"
+        raise InputError(path, None, field, f"{found}: a plot is written in the format its suffix names "
+                                            f"(one of {', '.join('.' + f for f in formats)})")
+    return path
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    return folder == path or folder in path.parents
+
+
+def check_outputs(files=(), folders=(), plots=(), inputs=()) -> None:
+    """``check_folder`` of every folder, ``check_plot`` of every plot, no two output files
+    the same, none of them an input file or inside an input folder (``inputs``: the
+    command's files and folders, including one it is about to build), then ``check_file``
+    of every file and plot (None entries skipped)."""
     for d in folders:
         if d is not None:
             check_folder(d)
-    for f in files:
+    outs = [Path(f) for f in (*files, *plots) if f is not None]
+    for f in outs:
+        if f.is_dir():
+            check_file(f)   # says: a folder, not a file
+    for f in plots:
         if f is not None:
-            check_file(f)
+            check_plot(f)
+    seen = {}
+    for f in outs:
+        real = f.resolve()
+        if real in seen:
+            raise InputError(f, None, "output file", "two outputs of the command go to this one file: "
+                                                     "the second would overwrite the first")
+        seen[real] = f
+    for i in (Path(i) for i in inputs if i is not None):
+        real = i.resolve()   # an input folder the command is about to make (a build) counts too
+        for f in outs:
+            if _inside(f.resolve(), real):
+                what = "is the input file" if real == f.resolve() else "lies inside the input folder"
+                raise InputError(f, None, "output file", f"{what} {i}: writing it would overwrite what the "
+                                                         "command reads or builds (choose another path)")
+    for f in outs:
+        check_file(f)
 
 
 def fallback_folders() -> list[Path]:

@@ -14,6 +14,8 @@ Initialisation resolves the feedthrough: connections are transferred twice insid
 initialization mode, so at t = 0 every load output reflects the initial motion.
 """
 import ctypes
+import math
+import numbers
 import sys
 import time as clock
 from pathlib import Path
@@ -348,6 +350,18 @@ def _check_algorithm(algorithm, where):
         raise InputError(where, None, "algorithm", unknown("algorithm", algorithm, ("jacobi", "gauss-seidel", "ecco")))
 
 
+def _check_parameters(parameters, manifest):
+    """``run``'s parameters: finite numbers, none on a connected input (the master sets it at
+    every step: the value would be lost).  Their names are checked once the FMUs are loaded."""
+    connected = {f"{dst}.{dvar}": f"{src}.{svar}" for src, svar, dst, dvar in manifest["connections"]}
+    for key, value in parameters.items():
+        if key in connected:
+            raise InputError("run", None, "parameters", f"{key} is an input connected to {connected[key]}: the "
+                                                        "master sets it at every step, a value given here would be lost")
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+            raise InputError("run", None, "parameters", f"{key} = {value!r}: expected a finite number")
+
+
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
         on_step=None, outputs=None, interval=None, sink=None):
     """Run a built scene (its folder), or a loaded ``System`` (initialised here, left loaded
@@ -365,9 +379,10 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     ``on_step``: called with the step count after each communication step (benchmarks).
     """
     own = not isinstance(folder, System)
-    if own:   # refuse ECCO before loading anything
-        _check_algorithm(algorithm or read_manifest(folder)["run"]["algorithm"],
-                         folder)
+    if own:   # refuse ECCO, and parameters on connected inputs or not numbers, before loading anything
+        manifest = read_manifest(folder)
+        _check_algorithm(algorithm or manifest["run"]["algorithm"], folder)
+        _check_parameters(parameters or {}, manifest)
     system = load(folder, parameters) if own else folder
     t = 0.0
     try:
@@ -393,9 +408,11 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                                                                               system.manifest.get("source", "run"),
                                                                               "run.interval")))
         if own:
+            connected = {f"{dst}.{dvar}" for _, _, dst, dvar in system.manifest["connections"]}
             check_names(system.parameters, [f"{name}.{v}" for name, inst in system.instances.items()
-                                            for v, c in inst.causality.items() if c in ("parameter", "input")],
-                        "run", "parameters", "parameter or input")
+                                            for v, c in inst.causality.items()
+                                            if c == "parameter" or (c == "input" and f"{name}.{v}" not in connected)],
+                        "run", "parameters", "parameter or unconnected input")
         settings = run_settings(system.manifest, step, algorithm, stop)
         rows = Recorder(n, step, len(record), thin, sink)
         if sink is not None:

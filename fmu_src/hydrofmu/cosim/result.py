@@ -91,6 +91,8 @@ class Result:
     def vector(self, instance: str, name: str, n: int | None = None) -> np.ndarray:
         """(n_times, n) array of ``instance.name[1..n]``; ``n`` defaults to every
         component recorded (``name[1]``, ``name[2]``, … as long as they exist)."""
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+            raise ValueError(f"n: the number of components must be a whole number ≥ 1, found {n!r}")
         if n is None:
             n = 0
             while f"{instance}.{name}[{n + 1}]" in self._index:
@@ -169,6 +171,8 @@ class Result:
         (``repr``).  The file appears whole or not at all; a missing folder is an
         InputError naming it (another failure to write, an OSError)."""
         path = Path(path)
+        if path.is_dir():
+            raise InputError(path, None, "output file", "is a folder, not a file")
         if not path.parent.is_dir():
             raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
         tmp = path.with_name(f".{path.name}.tmp")
@@ -189,7 +193,8 @@ class Result:
         if self.manifest is None:
             raise ValueError("this Result has no manifest, which the plot needs (which FMU is which body's "
                              "load, joint or dynamics): read the CSV with read_csv(path, manifest=BUILT_FOLDER)")
-        path = Path(path)
+        from ..writable import check_plot
+        path = check_plot(path)
         if not path.parent.is_dir():
             raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
         plot(self, self.manifest, path)

@@ -23,7 +23,8 @@ at every period is zero (WAMIT leaves out what it does not compute) and said in 
 a pair present at some periods and missing at others (a truncated or spliced file) is an
 error, and so is a pair of the finite periods missing from the PER = 0 (ω = ∞) rows.
 
-Refused (InputError naming the file and the field): a negative or repeated frequency, two
+Refused (InputError naming the file and the field): ``rho`` or ``g`` not a positive finite
+number, a ``water_depth`` not positive (inf is deep water), a negative or repeated frequency, two
 ω = ∞ rows, a non-numeric value, a ``rotation_center`` whose bodies are not the dofs'
 bodies.  Said in ``BemData.warnings`` (legal, but a reviewer would ask): no ρ or g in a
 Capytaine dataset.
@@ -34,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .lines import fortran_float
 
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 
@@ -73,10 +75,30 @@ def read_bem(path, ulen=None, rho=None):
     """Read a Capytaine dataset (.nc) or a WAMIT .1 file (by its extension)."""
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
-        return read_capytaine(path)
+        if ulen is not None:   # an option that would change nothing is not taken silently
+            raise InputError(path, None, "ulen", "applies to a nondimensional WAMIT .1 file only: a Capytaine "
+                                                 "dataset is in SI units already")
+        data = read_capytaine(path)
+        if len(data.omega) < 3:   # the transform needs a grid (WAMIT: the same rule on its periods)
+            raise InputError(path, None, "omega", f"{len(data.omega)} finite frequencies: at least 3 needed "
+                                                  "(the ω = 0 and ω = ∞ rows do not count)")
+        return data
     if path.suffix == ".1":
         return read_wamit(path, ulen, rho)
     raise InputError(path, None, "bem", "expected a Capytaine NetCDF dataset (.nc) or a WAMIT .1 file")
+
+
+def check_scalar(path, name, value):
+    """A dataset's ``rho``, ``g`` (positive, finite), ``water_depth`` (positive, inf: deep
+    water) or ``forward_speed`` (finite): else one InputError.  A NaN or a zero here would
+    pass every later comparison with the scene's values."""
+    if name in ("rho", "g") and not (np.isfinite(value) and value > 0):
+        raise InputError(path, None, name, f"must be a positive finite number, found {value:g}")
+    if name == "water_depth" and not value > 0:
+        raise InputError(path, None, name, f"must be positive (inf: deep water), found {value:g}")
+    if name == "forward_speed" and not np.isfinite(value):
+        raise InputError(path, None, name, f"must be a finite speed, found {value:g}")
+    return value
 
 
 def _check_finite(path, name, values, coords):
@@ -116,6 +138,8 @@ def read_capytaine(path):
             scalars[name] = float(v[0])
             if name in ds.dims:
                 ds = ds.squeeze(name, drop=True)
+    for name, value in scalars.items():
+        check_scalar(path, name, value)
     if scalars.get("forward_speed", 0.0) != 0.0:
         raise InputError(path, None, "forward_speed", f"{scalars['forward_speed']:g} m/s: only zero speed results "
                                                       "give Cummins' kernels")
@@ -250,7 +274,7 @@ def read_wamit(path, ulen, rho):
         vals = []
         for name, w in zip(names, words):
             try:
-                vals.append(float(w.replace("D", "E").replace("d", "e")))
+                vals.append(fortran_float(w))
             except ValueError:
                 raise InputError(path, number, name, f"not a number: {w!r}") from None
             if not np.isfinite(vals[-1]):

@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .bem import DOF_NAMES, _single_name
+from .lines import fortran_float
+from .bem import DOF_NAMES, _single_name, check_scalar
 
 
 @dataclass
@@ -92,11 +93,11 @@ def _open(path):
         raise InputError(path, None, "bem", f"cannot read as a NetCDF dataset ({exc})") from None
 
 
-def _scalar(ds, name):
+def _scalar(ds, name, path=None):
     if name not in ds.coords and name not in ds:
         return None
     v = np.atleast_1d(ds[name].values).astype(float)
-    return float(v[0]) if v.size == 1 else None
+    return check_scalar(path, name, float(v[0])) if v.size == 1 else None
 
 
 def _dof(path, name, ds, where):
@@ -107,9 +108,14 @@ def _dof(path, name, ds, where):
     return body or _single_name(ds), DOF_NAMES.index(dof) + 1
 
 
-def _complex(var):
+def _complex(var, path=None):
+    """Complex values split along ``complex`` (re, im, by label) or stored complex; real
+    values alone (a phase lost on export) are an error."""
     if "complex" in var.dims:
         return var.sel(complex="re").values + 1j * var.sel(complex="im").values
+    if not np.iscomplexobj(var.values):
+        raise InputError(path, None, var.name, "real values without a 'complex' (re, im) dimension: the phase "
+                                               "is missing (export with cpt.export_dataset)")
     return np.asarray(var.values)
 
 
@@ -137,11 +143,11 @@ def read_excitation(path, ulen=None, rho=None, g=None) -> ExcitationData:
 def _capytaine_excitation(path):
     ds = _open(path)
     if "excitation_force" in ds:
-        name, x = "excitation_force", _complex(ds["excitation_force"])
+        name, x = "excitation_force", _complex(ds["excitation_force"], path)
         var = ds["excitation_force"]
     elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
         name, var = "diffraction_force", ds["diffraction_force"]
-        x = _complex(var) + _complex(ds["Froude_Krylov_force"].transpose(*var.dims))
+        x = _complex(var, path) + _complex(ds["Froude_Krylov_force"].transpose(*var.dims), path)
     else:
         raise InputError(path, None, "excitation_force", "missing: the dataset has no excitation_force nor "
                                                          "diffraction_force + Froude_Krylov_force (solve the "
@@ -159,7 +165,13 @@ def _capytaine_excitation(path):
     omega, x = omega[order], x[order]
     if omega.size < 2 or np.any(np.diff(omega) <= 0):
         raise InputError(path, None, "omega", "at least two distinct finite frequencies needed for the excitation")
-    beta = np.degrees(np.atleast_1d(ds["wave_direction"].values.astype(float)))
+    rad = np.atleast_1d(ds["wave_direction"].values.astype(float))
+    if np.any(np.abs(rad) > 2 * np.pi + 1e-9):   # Capytaine's directions are radians
+        raise InputError(path, None, "wave_direction", f"{rad[np.argmax(np.abs(rad))]:g} is beyond ±2π: Capytaine "
+                                                       "gives directions in radians (degrees written here?)")
+    if len(set(np.round(np.mod(rad, 2 * np.pi), 9))) < rad.size:
+        raise InputError(path, None, "wave_direction", "a direction given twice (two columns for one heading)")
+    beta = np.degrees(rad)
     names = [str(n) for n in np.atleast_1d(ds["influenced_dof"].values)]
     dofs = [_dof(path, n, ds, "influenced_dof") for n in names]
     bad = ~np.isfinite(x)
@@ -170,7 +182,7 @@ def _capytaine_excitation(path):
                                            f"influenced_dof={names[k]}")
     bodies = list(dict.fromkeys(b for b, _ in dofs))
     return ExcitationData(str(path), "Capytaine", omega, beta, np.conj(x), dofs, bodies, _centres(ds, bodies),
-                          _scalar(ds, "rho"), _scalar(ds, "g"), _scalar(ds, "water_depth"))
+                          _scalar(ds, "rho", path), _scalar(ds, "g", path), _scalar(ds, "water_depth", path))
 
 
 def _numbers(path, names, minimum):
@@ -190,7 +202,7 @@ def _numbers(path, names, minimum):
         vals = []
         for name, w in zip(names, words):
             try:
-                v = float(w.replace("D", "E").replace("d", "e"))
+                v = fortran_float(w)
             except ValueError:
                 raise InputError(path, number, name, f"not a number: {w!r}") from None
             if not np.isfinite(v):
@@ -294,7 +306,7 @@ def _capytaine_hydrostatics(path):
                if "body" in v.dims else {bodies[0]: v.values.astype(float).tolist()})
     return HydrostaticsData(str(path), "Capytaine", stiffness, bodies, weight=bool(com), mass=mass,
                             center_of_mass=com, rotation_centers=_centres(ds, bodies),
-                            rho=_scalar(ds, "rho"), g=_scalar(ds, "g"))
+                            rho=_scalar(ds, "rho", path), g=_scalar(ds, "g", path))
 
 
 def _wamit_hydrostatics(path, ulen, rho, g):

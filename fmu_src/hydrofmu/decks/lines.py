@@ -10,8 +10,9 @@ FREAD, the free-format reader of SIMO and RIFLEX input (``fread_lines``, ``field
   specification``; ``UNIT NA SPEC`` is an error), case does not count; letters written beyond
   the capitals must spell the word (a longer word, such as a plural, may follow it in full);
   no extra words;
-- values are separated by blanks (tabs) and/or commas; a number may carry a Fortran ``D``
-  exponent (``2.5D+03``);
+- values are separated by blanks (tabs) and/or commas; a number is written as Fortran reads
+  it (``12``, ``-1.5``, ``.5``, ``2.``, ``1.5E3``, with a ``D`` exponent ``2.5D+03``):
+  ``1_000``, ``0x10`` or ``1,5`` are errors, not numbers Python would make of them;
 - ``/`` in place of a value gives that field its default (``fields(..., defaults=)``);
 - ``&`` at the end of a line continues it on the next line;
 - ``'`` starts a comment: a line whose first non-blank character is ``'`` is skipped, and
@@ -25,6 +26,7 @@ given once given twice, is an error; the line after a group must start a new one
 reader used and skipped, and its warnings, is kept in a ``Reading``.
 """
 import math
+import re
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -366,13 +368,25 @@ def _empty_field(text):
     return None
 
 
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([EeDd][+-]?\d+)?\Z", re.ASCII)
+
+
+def fortran_float(word):
+    """A number as Fortran reads it (``D`` exponents too), or ValueError: Python's float()
+    also takes ``1_000`` and digits no deck writes.  NaN and inf pass (callers say why
+    they are refused)."""
+    if not _NUMBER.match(word) and word.lstrip("+-").lower() not in ("nan", "inf", "infinity"):
+        raise ValueError(f"not a number: {word!r}")
+    return float(word.replace("D", "E").replace("d", "e"))
+
+
 def convert(line, name, word, typ):
     """One word as ``typ`` (float, int or str), or an error naming the field.  Numbers
     must be finite: NaN, inf and overflowing values (1e400) are errors here, for every deck."""
     if typ is str:
         return word
     try:
-        value = float(word.replace("D", "E").replace("d", "e"))
+        value = fortran_float(word)
         if typ is int and math.isfinite(value):
             if value != int(value):
                 raise ValueError

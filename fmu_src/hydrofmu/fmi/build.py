@@ -116,7 +116,8 @@ if _runtime is None or sys.modules.get("{runtime}.fmi.slave") is not _runtime:
             resources = kwargs.get("resources")
             while sys.path.count(resources) > 1:
                 sys.path.remove(resources)
-            super().__init__(**kwargs)
+            # ... and answers an exception here by releasing objects twice: never raise
+            _slave.start(self, super().__init__, kwargs)
 
     globals().update({model_id}={model_id}, _runtime=_slave)
 {model_id} = globals()["{model_id}"]
@@ -142,17 +143,23 @@ def build_fmu(instance, workdir, runtime, shim=True):
     script.write_text(SCRIPT.format(model_id=model_id, runtime=runtime, slave=SLAVES[type(instance.fmu)],
                                     description=instance.fmu.description))
     saved_path = list(sys.path)
+    loaded = {m for m in sys.modules if m.split(".")[0] == runtime}
     try:
         fmu = FmuBuilder.build_FMU(script, dest=workdir / "fmus", project_files=[rt, config],
                                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         slave = getattr(importlib.import_module(model_id), model_id)(
             instance_name="introspect", resources=str(stage))
+        if getattr(slave, "broken", None) is not None:
+            raise slave.broken
         t0 = starts.at_start(instance.name, slave)   # here: lazy imports still find the staged runtime
     finally:
         sys.path[:] = saved_path
         # a later load of the FMU must import its own copy: the staged one is deleted with
-        # the build folder, and a lazy import would then look for it there
-        for name in [m for m in sys.modules if m == model_id or m.split(".")[0] == runtime]:
+        # the build folder, and a lazy import would then look for it there.  Modules of this
+        # runtime loaded before the build stay: they belong to FMUs this process runs now
+        # (an FMU loaded in-process imports its runtime from its own resources folder)
+        for name in [m for m in sys.modules
+                     if m == model_id or (m.split(".")[0] == runtime and m not in loaded)]:
             del sys.modules[name]
     rewrite_model_description(fmu, slave)
     if shim:
@@ -271,6 +278,7 @@ def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None, r
     runtime = runtime_name() if flavour == "python" else None   # None: the compiled flavour
     for line in notes(scene, system):
         log(line)
+    check_target(scene, target)
     if check:
         return None
     if outdir.exists() and not outdir.is_dir():
@@ -285,6 +293,26 @@ def build_scene(scene, outdir, shim=True, log=print, check=False, inputs=None, r
         if created is not None and not target.exists():
             shutil.rmtree(created, ignore_errors=True)   # no empty folders left by a failed build
     return target
+
+
+def check_target(scene, target):
+    """A build replaces ``target`` (OUT/<scene name>) whole: refuse when that would delete
+    what is not a build (a folder without manifest.json holding files, e.g. the scene's
+    decks) or the scene's own files (a deck kept inside its build folder)."""
+    from ..api import scene_files
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise InputError(target, None, "output folder", "is a file, where the build's folder goes")
+    if target.is_dir() and any(target.iterdir()) and not (target / "manifest.json").is_file():
+        raise InputError(target, None, "output folder", "exists and is not a built scene (no manifest.json): a "
+                                                        "build replaces it whole and would delete what it holds; "
+                                                        "move it or build elsewhere (-o)")
+    real = target.resolve()
+    for f in [Path(scene.path)] * bool(getattr(scene, "path", None)) + (
+            scene_files(scene.path) if getattr(scene, "path", None) else []):
+        if real in Path(f).resolve().parents:
+            raise InputError(f, None, "output folder", f"lies inside {target}, which the build replaces whole: "
+                                                       "keep the scene's files out of its build folder")
 
 
 def _build_into(scene, outdir, target, system, runtime, shim, log, inputs=None):

@@ -614,6 +614,7 @@ typedef struct Slot {
     char *key;                    /* pythonfmu's fmi2Instantiate arguments (make_key) ... */
     size_t keylen;
     int again;                    /* ... seen before in this process: worth pooling */
+    int dead;                     /* pythonfmu answered fmi2Fatal: never called again (below) */
     struct Slot *next;            /* next pooled Slot */
 } Slot;
 
@@ -706,17 +707,40 @@ static void shim_step_finished(fmi2ComponentEnvironment e, fmi2Status st) {
     if (s && s->stepFinished) s->stepFinished(s->env, st);
 }
 
+/*
+ * fmi2Fatal from pythonfmu 0.7 means a Python exception reached it, and its handler has then
+ * released the slave object, its class and its message list while keeping the pointers: a
+ * later call would use freed objects and fmi2FreeInstance (or the fmi2Reset of the pool)
+ * would release them a second time, corrupting the heap of the Python the host runs -- in a
+ * Python host, a crash much later, anywhere.  hydrofmu's slaves never raise (slave.guarded,
+ * slave.start), so this is a last defence: such a component is never called again, never
+ * pooled and never freed (a few hundred bytes left behind).
+ */
+static fmi2Status after(Shim *s, fmi2Status st) {
+    if (st == fmi2Fatal) s->slot->dead = 1;
+    return truthful(s, st);
+}
+
+/* Can the component still be called?  If not, say why, once per call. */
+static int usable(Shim *s) {
+    if (!s->slot->dead) return 1;
+    shim_logger(s->slot, "", fmi2Error, "logStatusError",
+                "hydrofmu shim: this instance stopped at a fatal error; free it and instantiate again");
+    return 0;
+}
+
 /* ---- plain forwarders: unwrap the Shim, call the inner function ---- */
 #define FORWARD(name, params, args)                       \
     EXPORT fmi2Status fmi2##name params {                 \
         if (!ready() || !c) return fmi2Error;             \
         Shim *s_ = c;                                     \
+        if (!usable(s_)) return fmi2Error;                \
         c = s_->slot->inner;                              \
         s_->worst = fmi2OK;                               \
         GIL_TAKE;                                         \
         fmi2Status st_ = inner.name args;                 \
         GIL_GIVE;                                         \
-        return truthful(s_, st_);                         \
+        return after(s_, st_);                            \
     }
 FMI_STATUS_FUNCS(FORWARD)
 #undef FORWARD
@@ -805,9 +829,9 @@ static void flush(Slot *slot) {
     inner.GetReal(slot->inner, NULL, 0, NULL);
 }
 
-/* Free a Slot and its pythonfmu component. */
+/* Free a Slot and its pythonfmu component (a dead one is left as it is: see after()). */
 static void drop(Slot *slot) {
-    if (slot->inner) {
+    if (slot->inner && !slot->dead) {
         GIL_TAKE;
         flush(slot);
         inner.FreeInstance(slot->inner);
@@ -825,8 +849,9 @@ static Slot *reuse(Shim *s, const char *key, size_t len) {
     s->worst = fmi2OK;
     GIL_TAKE;
     fmi2Status st = inner.Reset(slot->inner);
+    if (st != fmi2Fatal) flush(slot); /* a slave that could not start says so in its log */
     GIL_GIVE;
-    if (truthful(s, st) <= fmi2Warning) return slot;
+    if (after(s, st) <= fmi2Warning) return slot;
     slot->host = NULL;
     drop(slot);
     return NULL;
@@ -882,8 +907,9 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     GIL_TAKE;
     slot->again = seen(key, len);
     slot->inner = inner.Instantiate(name, type, guid, res, &slot->cb, visible, 1);
+    if (slot->inner) flush(slot);
     GIL_GIVE;
-    if (!slot->inner) {
+    if (!slot->inner || s->worst >= fmi2Error) { /* a slave that could not start logged why */
         drop(slot);
         s->release(s);
         return NULL;
@@ -896,11 +922,13 @@ EXPORT void fmi2FreeInstance(fmi2Component c) {
     if (!s) return;
     Slot *slot = s->slot;
     if (ready()) { /* may still log: s stays valid until after */
-        GIL_TAKE;
-        flush(slot); /* to this host, also when the Slot is pooled */
-        GIL_GIVE;
+        if (!slot->dead) {
+            GIL_TAKE;
+            flush(slot); /* to this host, also when the Slot is pooled */
+            GIL_GIVE;
+        }
         int keep = 0;
-        if (slot->again && !no_pool) {
+        if (slot->again && !no_pool && !slot->dead) {
             pin(); /* pooled components call back into this library */
             pthread_mutex_lock(&pool.lock);
             keep = pinned && pool.nidle < POOL_MAX;
@@ -946,32 +974,36 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n,
     s->cats = cats;
     s->ncat = n;
     s->logging = on != 0;
+    if (!usable(s)) return fmi2Error;
     GIL_TAKE;
     fmi2Status st = inner.SetDebugLogging(s->slot->inner, 1, 0, NULL);
     GIL_GIVE;
-    return st;
+    return after(s, st);
 }
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior) {
     if (!ready() || !c) return fmi2Error;
     Shim *sh = c;
+    if (!usable(sh)) return fmi2Error;
     sh->worst = fmi2OK;
     GIL_TAKE;
     fmi2Status s = inner.DoStep(sh->slot->inner, t, h, noPrior);
     GIL_GIVE;
     sh->stepped |= s == fmi2OK || s == fmi2Discard; /* when pythonfmu records the time */
-    return truthful(sh, s == fmi2Discard ? fmi2Error : s);
+    return after(sh, s == fmi2Discard ? fmi2Error : s);
 }
 
 EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     if (!ready() || !c) return fmi2Error;
     Shim *sh = c;
+    if (!usable(sh)) return fmi2Error;
     sh->worst = fmi2OK;
     sh->stepped = 0;
     GIL_TAKE;
     fmi2Status s = inner.Reset(sh->slot->inner);
+    if (s != fmi2Fatal) flush(sh->slot); /* a slave that could not start again says so */
     GIL_GIVE;
-    return truthful(sh, s);
+    return after(sh, s);
 }
 
 /*
@@ -985,9 +1017,10 @@ EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi
         *v = NAN;
         return fmi2OK;
     }
+    if (!usable(sh)) return fmi2Error;
     sh->worst = fmi2OK;
     GIL_TAKE;
     fmi2Status s = inner.GetRealStatus(sh->slot->inner, k, v);
     GIL_GIVE;
-    return truthful(sh, s);
+    return after(sh, s);
 }

@@ -135,6 +135,24 @@ def guarded(fallback=None, computes=True):
     return wrap
 
 
+def start(slave, init, kwargs):
+    """Run a slave's constructor for pythonfmu without letting an exception out.
+
+    pythonfmu 0.7 answers an exception in the constructor (in fmi2Instantiate, or in the
+    fmi2Reset with which the shim reuses an instance) by releasing the slave's class and
+    message list, and releases them again when the instance is freed: in a Python host that
+    corrupts the heap (a crash later, anywhere).  The failure is logged as an error instead
+    and kept in ``slave.broken``; the shim then fails fmi2Instantiate with that message."""
+    try:
+        init(**kwargs)
+    except Exception as exc:
+        if not hasattr(slave, "log_queue"):   # pythonfmu's part did not run: its queue first
+            Fmi2Slave.__init__(slave, **kwargs)
+        slave.broken = exc
+        slave.log(f"{kwargs.get('instance_name')}: cannot start: {type(exc).__name__}: {exc}",
+                  Fmi2Status.error)
+
+
 class ArraySlave(Fmi2Slave):
     """Base slave: Reals in one array, units and output dependencies recorded."""
 
