@@ -47,10 +47,12 @@ def compiled_slave(fmu, unzipped, name="compiled"):
     return md, s
 
 
-def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0, params=None):
+def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0, params=None, hold=1):
     """(Python outputs, compiled outputs, output names) of both flavours of ``fmu`` driven
     by the same inputs (and the parameters ``params`` {name: value} it has, set in
-    initialization mode): rows are communication points, columns outputs."""
+    initialization mode): rows are communication points, columns outputs.  ``hold`` > 1: the
+    inputs change every ``hold`` steps only (set every step: the compiled FMU keeps its outputs
+    when the values set are those it holds)."""
     unzipped = Path(tmp) / Path(fmu).stem
     with zipfile.ZipFile(fmu) as z:
         z.extractall(unzipped)
@@ -78,7 +80,7 @@ def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0, params=None):
     p_rows, c_rows = [], []
     for n in range(steps):
         t = n * dt
-        u = (start + amp * np.sin(2 * np.pi * freq * t + phase)).tolist()
+        u = (start + amp * np.sin(2 * np.pi * freq * (n // hold * hold * dt) + phase)).tolist()
         py.set_real(vin, u)
         c.setReal(vin, u)
         p_rows.append(py.get_real(vout))
@@ -90,14 +92,14 @@ def drive(fmu, tmp, steps=STEPS, dt=0.1, seed=0, params=None):
     return np.array(p_rows), np.array(c_rows), [v.name for v in outs]
 
 
-def assert_equal_flavours(folder, tmp, steps=STEPS, dt=0.1, seed=0, params=None, loads_only=False):
+def assert_equal_flavours(folder, tmp, steps=STEPS, dt=0.1, seed=0, params=None, loads_only=False, hold=1):
     """Every output of every FMU (``loads_only``: of every load FMU) of a built scene folder:
     compiled = Python to 1e-10 of its range."""
     fmus = [f for f in sorted(Path(folder).glob("*.fmu")) if not (loads_only and f.stem.endswith("_dynamics"))]
     assert fmus
     worst = 0.0
     for fmu in fmus:
-        p, c, names = drive(fmu, tmp, steps, dt, seed, params)
+        p, c, names = drive(fmu, tmp, steps, dt, seed, params, hold)
         assert np.isfinite(p).all()
         span = p.max(axis=0) - p.min(axis=0)
         scale = np.where(span > 0, span, np.abs(p).max(axis=0))
@@ -218,7 +220,7 @@ def test_random_scene_compiled_equals_python(seed, tmp_path):
     # two load FMUs, two joints; the dynamics: one group (export: cross added mass) or one each
     dynamics = {f"random{seed}_a_b_dynamics"} if seed % 2 == 0 else {f"random{seed}_a_dynamics", f"random{seed}_b_dynamics"}
     assert fmus == {f"random{seed}_{n}" for n in ("a", "b", "hitch", "anchor")} | dynamics
-    assert assert_equal_flavours(folder, tmp_path, seed=seed) <= 1e-10
+    assert assert_equal_flavours(folder, tmp_path, seed=seed, hold=seed) <= 1e-10   # seed 2: inputs held 2 steps
 
 
 def variables(md_text):
@@ -717,7 +719,7 @@ def test_random_wave_scene_compiled_equals_python(seed, tmp_path):
     from hydrofmu.scene import load_scene
     folder = build_scene(load_scene(random_wave_scene(seed, tmp_path)), tmp_path / "fmus", log=lambda *_: None,
                          runtime="c")
-    assert assert_equal_flavours(folder, tmp_path, seed=seed, loads_only=True) <= 1e-10
+    assert assert_equal_flavours(folder, tmp_path, seed=seed, loads_only=True, hold=3) <= 1e-10
 
 
 def test_bad_sea_state_fails_initialization_naming_the_knob(wave_builds, tmp_path, capfd):

@@ -48,25 +48,28 @@ def build_floor(folder) -> Path:
 
 
 def compare(candidates, floor_fmu, out, rounds=5, steps=200_000, dt=0.05, best_of=STARTUP_BEST):
-    """{label: compiled FMU} against the native floor in the C timing host, rows {label,
-    step_us, step_floor_us, step_x, startup_ms, startup_floor_ms, startup_x, *_spread, *_noisy}."""
+    """{label: compiled FMU, or (FMU, vary)} against the native floor in the C timing host, both
+    with the same inputs every step or (vary) inputs that change at every step (native_host.c);
+    rows {label, step_us, step_floor_us, step_x, startup_ms, startup_floor_ms, startup_x,
+    *_spread, *_noisy}."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     exe = native.host(out)
     floor_args = native.unpack(floor_fmu, out / "floor")
-    unpacked = {label: native.unpack(f, out / f"c{k}") for k, (label, f) in enumerate(candidates.items())}
+    candidates = {label: f if isinstance(f, tuple) else (f, False) for label, f in candidates.items()}
+    unpacked = {label: (native.unpack(f, out / f"c{k}"), vary) for k, (label, (f, vary)) in enumerate(candidates.items())}
 
-    def measure(args):
+    def measure(args, vary):
         """(startup [s], seconds per step), each the best of ``best_of`` fresh processes (noise
         only adds time: a floor's loop of 200 000 steps lasts ~10 ms)."""
-        args = list(map(str, args[:3])) + [str(steps), repr(dt)] + list(args[3:])
+        args = list(map(str, args[:3])) + [str(steps), repr(dt)] + list(args[3:]) + [str(int(vary))]
         got = [native._json([str(exe), *args]) for _ in range(best_of)]
         return min(g["startup_s"] for g in got), min(g["step_s"] for g in got)
 
     got = {label: [] for label in candidates}
     for _ in range(rounds):
-        for label, args in unpacked.items():
-            (fs, fp), (cs, cp) = measure(floor_args), measure(args)
+        for label, (args, vary) in unpacked.items():
+            (fs, fp), (cs, cp) = measure(floor_args, vary), measure(args, vary)
             got[label].append([fs, cs, fp, cp])
     rows = []
     for label, t in got.items():
@@ -112,12 +115,15 @@ def part(out, quick, pythonfmu_floor):
     drag = build_scene(load_scene(design_scene(out)), out / "scenes", log=quiet, runtime="c")
     joined = build_scene(load_scene(Path(__file__).resolve().parents[3] / "models" / "joined_barges.toml"),
                          out / "scenes", log=quiet, runtime="c")
-    candidates = {"load FMU, state-space memory + drag": drag / "side_by_side_barge_a.fmu",
-                  "dynamics FMU, two coupled bodies": drag / "side_by_side_barge_a_barge_b_dynamics.fmu",
-                  "joint FMU (CONB)": joined / "joined_barges_hitch.fmu"}
+    load = drag / "side_by_side_barge_a.fmu"
+    candidates = {"load FMU, state-space memory + drag, inputs changing every step": (load, True),
+                  "load FMU, state-space memory + drag, the same inputs every step": load,
+                  "dynamics FMU, two coupled bodies, inputs changing every step":
+                      (drag / "side_by_side_barge_a_barge_b_dynamics.fmu", True),
+                  "joint FMU (CONB), inputs changing every step": (joined / "joined_barges_hitch.fmu", True)}
     rows = compare(candidates, cfloor, out / "unzipped", rounds=3 if quick else 5, steps=20_000 if quick else 200_000,
                    best_of=1 if quick else STARTUP_BEST)
-    f = rows[0]
+    f = rows[0]   # the target's: inputs that change every step, as in a co-simulation
     lines = [f"native floor (trivial compiled FMU, C host): {f['step_floor_us']:.2f} µs per step "
              f"(set 6, doStep, get 6), startup {f['startup_floor_ms']:.2f} ms"]
 
@@ -146,4 +152,12 @@ def part(out, quick, pythonfmu_floor):
                      f"({r['step_x']:.2f}× the pythonfmu floor), real-time factor {step / (1e-6 * r['step_us']):.0f}; "
                      f"startup {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× the floor)"
                      + (" [noisy]" if r["step_noisy"] or r["startup_noisy"] else ""))
+    # the compiled design scene in libcosim (its C++ master, called through libcosimpy) against
+    # our master on the same FMUs: libcosim's own cost per step shows without the FMUs' Python
+    r = native.compare_scene(both["side_by_side, compiled flavour"], rounds=2 if quick else 5,
+                             steps=200 if quick else 2000)
+    lines.append(f"side_by_side, compiled flavour in libcosim: {r['step_us']:.0f} µs per step "
+                 f"({r['step_x']:.2f}× our master on the same FMUs, {r['step_fmpy_us']:.0f} µs), real-time factor "
+                 f"{step / (1e-6 * r['step_us']):.0f}; startup {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× ours)"
+                 + (" [noisy]" if r["step_noisy"] or r["startup_noisy"] else ""))
     return lines

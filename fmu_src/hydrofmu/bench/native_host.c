@@ -1,12 +1,15 @@
 /*
  * A native FMI 2.0 co-simulation host for timing (bench/native.py): no Python of its own.
  *
- *   native_host DIR ID GUID STEPS DT INPUTS OUTPUTS
+ *   native_host DIR ID GUID STEPS DT INPUTS OUTPUTS [VARY]
  *
  * DIR is an unzipped FMU, ID its model identifier.  One instance in the main thread:
  * dlopen, fmi2Instantiate and initialisation (the startup), then STEPS steps of
  * fmi2SetReal(INPUTS "vr:value,...") + fmi2DoStep(DT) + fmi2GetReal(OUTPUTS "vr,..."),
- * then fmi2Terminate + fmi2FreeInstance.  Prints one JSON line:
+ * then fmi2Terminate + fmi2FreeInstance.  VARY 1: the inputs change at every step (each
+ * one's value, then that plus 1e-6 of it and 1e-9, alternately: what a master sets as the
+ * partners move; an FMU cannot keep its outputs from the step before); default 0: the same
+ * values every step.  Prints one JSON line:
  * {"startup_s": ..., "step_s": seconds per step, "free_s": ..., "failed": 0 or 1}.
  */
 #define _POSIX_C_SOURCE 199309L
@@ -29,19 +32,21 @@ static double now(void) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 8) {
-        fprintf(stderr, "usage: %s DIR ID GUID STEPS DT INPUTS OUTPUTS\n", argv[0]);
+    if (argc != 8 && argc != 9) {
+        fprintf(stderr, "usage: %s DIR ID GUID STEPS DT INPUTS OUTPUTS [VARY]\n", argv[0]);
         return 2;
     }
+    int vary = argc == 9 && atoi(argv[8]) != 0;
     const char *dir = argv[1], *id = argv[2], *guid = argv[3];
     long steps = atol(argv[4]);
-    double dt = atof(argv[5]), in[64], out[64];
+    double dt = atof(argv[5]), in[64], out[64], moved[64];
     unsigned in_vr[64], out_vr[64];
     int nin = 0, nout = 0;
     for (char *p = strtok(argv[6], ","); p && nin < 64; p = strtok(NULL, ","), nin++)
         sscanf(p, "%u:%lf", &in_vr[nin], &in[nin]);
     for (char *p = strtok(argv[7], ","); p && nout < 64; p = strtok(NULL, ","), nout++)
         sscanf(p, "%u", &out_vr[nout]);
+    for (int k = 0; k < nin; k++) moved[k] = in[k] + 1e-6 * in[k] + 1e-9;
     char uri[4200];
     snprintf(uri, sizeof uri, "file://%s/resources", dir);
     double t0 = now();
@@ -57,7 +62,8 @@ int main(int argc, char **argv) {
               fmi.ExitInitializationMode(c);
     double t1 = now();
     for (long n = 0; n < steps && !bad; n++)
-        bad = fmi.SetReal(c, in_vr, nin, in) || fmi.DoStep(c, n * dt, dt, 1) || fmi.GetReal(c, out_vr, nout, out);
+        bad = fmi.SetReal(c, in_vr, nin, vary && (n & 1) ? moved : in) || fmi.DoStep(c, n * dt, dt, 1) ||
+              fmi.GetReal(c, out_vr, nout, out);
     double t2 = now();
     fmi.Terminate(c);
     fmi.FreeInstance(c);

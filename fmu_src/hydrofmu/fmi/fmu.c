@@ -6,6 +6,11 @@
  * fmi2Error with one log line naming the variable, and no entry point crashes on bad
  * arguments (NULL instance, value reference out of range, NULL arrays).
  *
+ * One evaluation per step: fmi2DoStep checks the inputs, moves the model over the step and
+ * evaluates the outputs at its end once (their finiteness checked there); fmi2GetReal then
+ * copies them.  Outputs are evaluated again only when an input changes (fmi2SetReal of the
+ * value an input already holds changes nothing), and then only what depends on it.
+ *
  * Resources: variables.txt ("hydrofmu-c 1 <guid>", then "<causality> <name>" per value
  * reference) and model.bin (records: 32-byte tag, int64 count, that many float64, little
  * endian), both written by hydrofmu.fmi.cbuild.
@@ -170,11 +175,14 @@ static int read_variables(Instance *inst, const char *folder, const char *guid) 
     fclose(f);
     inst->nvars = n;
     if (!inst->names || !inst->causality) return -1;
-    inst->noutputs = 0;
+    inst->noutputs = inst->ninputs = 0;
     inst->outputs = calloc(n + 1, sizeof(int));
-    if (!inst->outputs) return -1;
-    for (int k = 0; k < n; k++)
+    inst->inputs = calloc(n + 1, sizeof(int));
+    if (!inst->outputs || !inst->inputs) return -1;
+    for (int k = 0; k < n; k++) {
         if (inst->causality[k] == 'o') inst->outputs[inst->noutputs++] = k;
+        if (inst->causality[k] == 'i') inst->inputs[inst->ninputs++] = k;
+    }
     return 0;
 }
 
@@ -235,7 +243,7 @@ static void free_instance(Instance *inst) {
     if (inst->model && inst->model->release) inst->model->release(inst);
     for (int k = 0; k < inst->nvars && inst->names; k++) free(inst->names[k]);
     for (int k = 0; k < inst->nrec; k++) free(inst->rec[k].v);
-    free(inst->names), free(inst->causality), free(inst->outputs), free(inst->rec);
+    free(inst->names), free(inst->causality), free(inst->outputs), free(inst->inputs), free(inst->rec);
     free(inst->values), free(inst->start), free(inst->name);
     free(inst);
 }
@@ -245,7 +253,7 @@ static int restart(Instance *inst) {
     if (inst->model->release) inst->model->release(inst);
     inst->data = NULL;
     memcpy(inst->values, inst->start, sizeof(double) * inst->nvars);
-    inst->running = 0, inst->stale = 1, inst->suspect = 1, inst->has_next = 0, inst->error[0] = 0;
+    inst->running = 0, inst->stale = 1, inst->suspect = 1, inst->changed = 1, inst->has_next = 0, inst->error[0] = 0;
     return inst->model->setup(inst);
 }
 
@@ -356,7 +364,14 @@ static int bad_refs(Instance *inst, const char *call, const fmi2ValueReference *
     return 0;
 }
 
+/* 1: the inputs are finite (checked once after they were set), else inst->error names one */
+static int inputs_finite(Instance *inst) {
+    if (inst->suspect && hf_check_finite(inst, inst->inputs, inst->ninputs)) inst->suspect = 0;
+    return !inst->suspect;
+}
+
 static void evaluate(Instance *inst) {
+    if (!inputs_finite(inst)) return;   /* (stale stays: the next read fails too) */
     inst->stale = 0;
     inst->model->evaluate(inst);
 }
@@ -365,36 +380,51 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
     ENTER(c);
     if (bad_refs(inst, "fmi2GetReal", vr, n, value)) return fmi2Error;
     if (inst->stale) evaluate(inst);
-    for (size_t k = 0; k < n; k++) value[k] = inst->values[vr[k]];
     if (inst->error[0]) {   /* kept: the next fmi2DoStep fails on it too */
+        for (size_t k = 0; k < n; k++) value[k] = inst->values[vr[k]];
         hf_fail(inst, "%s", inst->error);
         return fmi2Error;
     }
-    for (size_t k = 0; k < n; k++)
-        if (!isfinite(value[k])) {
-            hf_fail(inst, "%s %s = %g is not finite", inst->causality[vr[k]] == 'o' ? "output" : "variable",
-                    inst->names[vr[k]], value[k]);
-            break;
-        }
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) sum += value[k] = inst->values[vr[k]];
+    if (!isfinite(sum))
+        for (size_t k = 0; k < n; k++)
+            if (!isfinite(value[k])) {
+                hf_fail(inst, "%s %s = %g is not finite", inst->causality[vr[k]] == 'o' ? "output" : "variable",
+                        inst->names[vr[k]], value[k]);
+                break;
+            }
     return (fmi2Status)inst->status;
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[]) {
     ENTER(c);
-    if (bad_refs(inst, "fmi2SetReal", vr, n, value)) return fmi2Error;
-    for (size_t k = 0; k < n; k++) {
-        char cs = inst->causality[vr[k]];
-        if (!(cs == 'i' || (cs == 'p' && !inst->running))) {
-            const char *why = cs == 'p' ? "a parameter, fixed after initialization"
-                            : cs == 'o' ? "not settable (output)"
-                            : cs == 'c' ? "not settable (calculatedParameter)" : "not settable (local)";
-            hf_fail(inst, "cannot set %s: %s", inst->names[vr[k]], why);
+    if (n && (!vr || !value)) {
+        hf_fail(inst, "fmi2SetReal: NULL value references or values for %zu variables", n);
+        return fmi2Error;
+    }
+    for (size_t k = 0; k < n; k++) {   /* every reference checked before any value is set */
+        char cs = vr[k] < (fmi2ValueReference)inst->nvars ? inst->causality[vr[k]] : 0;
+        if (cs == 'i' || (cs == 'p' && !inst->running)) continue;
+        if (!cs) {
+            hf_fail(inst, "fmi2SetReal: value reference %u out of range 0...%d", vr[k], inst->nvars - 1);
             return fmi2Error;
         }
+        const char *why = cs == 'p' ? "a parameter, fixed after initialization"
+                        : cs == 'o' ? "not settable (output)"
+                        : cs == 'c' ? "not settable (calculatedParameter)" : "not settable (local)";
+        hf_fail(inst, "cannot set %s: %s", inst->names[vr[k]], why);
+        return fmi2Error;
     }
-    for (size_t k = 0; k < n; k++) inst->values[vr[k]] = value[k];
-    inst->stale = 1, inst->suspect = 1;
-    inst->error[0] = 0;   /* new inputs: the next evaluation checks them afresh */
+    int changed = 0;
+    for (size_t k = 0; k < n; k++) {   /* (a NaN never equals what is there: it counts as changed) */
+        changed |= inst->values[vr[k]] != value[k];
+        inst->values[vr[k]] = value[k];
+    }
+    if (changed) {
+        inst->stale = 1, inst->suspect = 1, inst->changed = 1;
+        inst->error[0] = 0;   /* new inputs: the next evaluation checks them afresh */
+    }
     return fmi2OK;
 }
 
@@ -452,18 +482,21 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
     else if (inst->has_next && fabs(t - inst->next_time) > 1e-6 * h + 1e-12 * fabs(inst->next_time))
         hf_set_error(inst, "communication point %.17g is not where the last step ended (%.17g); restore an FMU "
                      "state (fmi2SetFMUstate) to go back or forward", t, inst->next_time);
-    if (inst->stale && !inst->error[0]) evaluate(inst);
-    if (!inst->error[0]) {
-        if (!outputs_finite(inst)) return fmi2Error;   /* the step starts from non-finite outputs */
+    if (!inst->error[0] && inputs_finite(inst)) {
+        /* the outputs at the step's start are not evaluated unless read: the step needs the
+         * inputs only, and the outputs at its end (evaluated once, here) are what a master reads */
         inst->model->step(inst, t, h);
-        if (!inst->error[0] && !inst->stale && !outputs_finite(inst)) return fmi2Error;
+        if (!inst->error[0]) {
+            inst->next_time = t + h, inst->has_next = 1;   /* (the outputs' time: waves) */
+            if (inst->stale) evaluate(inst);
+            if (!inst->error[0] && !outputs_finite(inst)) return fmi2Error;
+        }
     }
     if (inst->error[0]) {
         hf_fail(inst, "at t=%.17g: %s", t, inst->error);
         inst->error[0] = 0;
         return fmi2Error;
     }
-    inst->next_time = t + h, inst->has_next = 1;
     return (fmi2Status)inst->status;
 }
 
@@ -521,7 +554,7 @@ static fmi2Status set_state(Instance *inst, const double *d, size_t n) {
         return fmi2Error;
     }
     inst->running = d[0] != 0.0, inst->has_next = d[1] != 0.0, inst->next_time = d[2];
-    inst->stale = 1, inst->suspect = 1, inst->error[0] = 0;
+    inst->stale = 1, inst->suspect = 1, inst->changed = 1, inst->error[0] = 0;
     return fmi2OK;
 }
 

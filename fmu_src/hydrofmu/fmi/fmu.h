@@ -41,6 +41,7 @@ struct Instance {
     char **names;           /* variable names */
     char *causality;        /* 'p' parameter, 'c' calculated parameter, 'i' input, 'o' output, 'l' local */
     int *outputs, noutputs;
+    int *inputs, ninputs;   /* value references of the outputs and of the inputs */
     int nrec;
     Record *rec;
     const Model *model;
@@ -48,6 +49,7 @@ struct Instance {
     int running;            /* after initialization: parameters fixed */
     int stale;              /* outputs to evaluate before they are read */
     int suspect;            /* inputs set since the last check may be non-finite */
+    int changed;            /* inputs or parameters changed since the model's last evaluation (it clears it) */
     int has_next;
     double next_time;       /* where the next fmi2DoStep must start */
     char error[512];        /* a bad input seen since the last step ("" none) */

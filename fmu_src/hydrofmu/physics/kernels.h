@@ -90,6 +90,9 @@ typedef struct {
     double *z;                   /* 2m: (re, im) per mode */
     double v[6], force[6];       /* velocity and load at the current time */
     double dt, *coef;            /* the last step's coefficients: 6 per mode (e, b_old, b_new) */
+    double *base;                /* e z + b_old v of the step from the state now (2m; has_base) */
+    int *io;                     /* inp and out as integers (2m) */
+    int has_base;
     double *pz, pv[6], pforce[6], pdt;   /* the last peek */
     int peeked;
 } HfStateSpace;

@@ -41,21 +41,32 @@ int hf_ss_init(HfStateSpace *ss, const double *params, int n) {
     ss->z = calloc(2 * (size_t)m + 1, sizeof(double));
     ss->pz = calloc(2 * (size_t)m + 1, sizeof(double));
     ss->coef = calloc(6 * (size_t)m + 1, sizeof(double));
+    ss->base = calloc(2 * (size_t)m + 1, sizeof(double));
+    ss->io = calloc(2 * (size_t)m + 1, sizeof(int));
     ss->dt = -1.0;
-    return ss->z && ss->pz && ss->coef ? 0 : -1;
+    if (!ss->z || !ss->pz || !ss->coef || !ss->base || !ss->io) return -1;
+    for (int k = 0; k < m; k++) {
+        ss->io[2 * k] = (int)ss->inp[k], ss->io[2 * k + 1] = (int)ss->out[k];
+        if (ss->io[2 * k] < 0 || ss->io[2 * k] > 5 || ss->io[2 * k + 1] < 0 || ss->io[2 * k + 1] > 5) return -1;
+    }
+    return 0;
 }
 
 void hf_ss_free(HfStateSpace *ss) {
-    free(ss->z), free(ss->pz), free(ss->coef);
-    ss->z = ss->pz = ss->coef = NULL;
+    free(ss->z), free(ss->pz), free(ss->coef), free(ss->base), free(ss->io);
+    ss->z = ss->pz = ss->coef = ss->base = NULL;
+    ss->io = NULL;
 }
 
 void hf_ss_restart(HfStateSpace *ss, const double *v) {
     memcpy(ss->v, v, sizeof ss->v);
-    ss->peeked = 0;
+    ss->peeked = ss->has_base = 0;
 }
 
-/* The step's state into pz and load into pforce, nothing moved. */
+/* The step's state into pz and load into pforce, nothing moved.  The part that does not
+ * depend on the velocity at the step's end (e z + b_old v_old) is kept until the state moves:
+ * the peeks of one step (the read after fmi2DoStep, the next fmi2DoStep with new inputs)
+ * share it, the same sums in the same order as one expression. */
 static void ss_step(HfStateSpace *ss, double dt, const double *v) {
     int m = ss->m;
     if (dt != ss->dt) {   /* coefficients of a new step length (a constant step: once) */
@@ -67,19 +78,26 @@ static void ss_step(HfStateSpace *ss, double dt, const double *v) {
             c[0] = creal(e), c[1] = cimag(e), c[2] = creal(bo), c[3] = cimag(bo), c[4] = creal(bn), c[5] = cimag(bn);
         }
         ss->dt = dt;
+        ss->has_base = 0;
+    }
+    if (!ss->has_base) {
+        for (int k = 0; k < m; k++) {
+            const double *c = ss->coef + 6 * k;
+            double zr = ss->z[2 * k], zi = ss->z[2 * k + 1], vo = ss->v[ss->io[2 * k]];
+            ss->base[2 * k] = c[0] * zr - c[1] * zi + c[2] * vo;
+            ss->base[2 * k + 1] = c[1] * zr + c[0] * zi + c[3] * vo;
+        }
+        ss->has_base = 1;
     }
     double f[6] = {0};
     for (int k = 0; k < m; k++) {
         const double *c = ss->coef + 6 * k;
-        int j = (int)ss->inp[k];
-        double zr = ss->z[2 * k], zi = ss->z[2 * k + 1], vo = ss->v[j], vn = v[j];
-        double nr = c[0] * zr - c[1] * zi + c[2] * vo + c[4] * vn;
-        double ni = c[1] * zr + c[0] * zi + c[3] * vo + c[5] * vn;
+        double vn = v[ss->io[2 * k]];
+        double nr = ss->base[2 * k] + c[4] * vn, ni = ss->base[2 * k + 1] + c[5] * vn;
         ss->pz[2 * k] = nr, ss->pz[2 * k + 1] = ni;
-        f[(int)ss->out[k]] += -ss->gam_re[k] * nr + ss->gam_im[k] * ni;
+        f[ss->io[2 * k + 1]] += -ss->gam_re[k] * nr + ss->gam_im[k] * ni;
     }
-    if (m) memcpy(ss->pforce, f, sizeof f);
-    else memcpy(ss->pforce, ss->force, sizeof f);
+    for (int i = 0; i < 6; i++) ss->pforce[i] = m ? f[i] : ss->force[i];
     memcpy(ss->pv, v, sizeof ss->pv);
     ss->pdt = dt;
     ss->peeked = 1;
@@ -96,7 +114,7 @@ void hf_ss_advance(HfStateSpace *ss, double dt, const double *v) {
     ss->z = ss->pz, ss->pz = t;
     memcpy(ss->v, ss->pv, sizeof ss->v);
     memcpy(ss->force, ss->pforce, sizeof ss->force);
-    ss->peeked = 0;
+    ss->peeked = ss->has_base = 0;
 }
 
 size_t hf_ss_state_size(const HfStateSpace *ss) { return 2 * (size_t)ss->m + 12; }
@@ -112,7 +130,7 @@ int hf_ss_load(HfStateSpace *ss, const double *from, size_t n) {
     memcpy(ss->z, from, sizeof(double) * 2 * ss->m);
     memcpy(ss->v, from + 2 * ss->m, sizeof ss->v);
     memcpy(ss->force, from + 2 * ss->m + 6, sizeof ss->force);
-    ss->peeked = 0;
+    ss->peeked = ss->has_base = 0;
     return 0;
 }
 
