@@ -251,11 +251,13 @@ def test_model_description_is_the_python_flavours(compiled, demo_build):
         assert (demo_build / name).read_text() == (compiled["moored_barge"] / name).read_text()
 
 
-def test_fmpy_validates_compiled_fmus_of_every_kind(compiled):
-    """A load FMU with couplings, a joint and a dynamics group: 0 problems."""
+def test_fmpy_validates_compiled_fmus_of_every_kind(compiled, wave_builds):
+    """A load FMU with couplings, one with waves and hydrostatics, a joint and a dynamics
+    group: 0 problems."""
     from fmpy.validation import validate_fmu
     for fmu in (compiled["side_by_side"] / "side_by_side_barge_a.fmu", compiled["joined_barges"] / "joined_barges_hitch.fmu",
-                compiled["side_by_side"] / "side_by_side_barge_a_barge_b_dynamics.fmu"):
+                compiled["side_by_side"] / "side_by_side_barge_a_barge_b_dynamics.fmu",
+                wave_builds["irregular"] / "waves_cyl1.fmu"):
         assert validate_fmu(str(fmu)) == [], fmu.name
 
 
@@ -343,17 +345,18 @@ def test_nonfinite_input_is_an_error_with_a_log_line_not_a_crash(compiled, hosts
 
 # -- FMU state, reset and guards (fmpy) -----------------------------------------------------
 
-def test_state_serialize_and_reset_continue_exactly(compiled, tmp_path):
+def test_state_serialize_and_reset_continue_exactly(compiled, wave_builds, tmp_path):
     """A state taken mid-run, serialized and restored (into the same instance and into a fresh
-    one) continues with the same outputs; fmi2Reset starts again from the start values.
-    Memories of both kinds (state space: side_by_side; convolution: a random scene)."""
+    one, which draws its waves from the restored waves.* values) continues with the same
+    outputs; fmi2Reset starts again from the start values.  Memories of both kinds (state
+    space: side_by_side; convolution: a random scene), waves."""
     from hydrofmu.fmi.build import build_scene
     from hydrofmu.scene import load_scene
     from conftest import write_scene
     conv = build_scene(load_scene(write_scene(tmp_path / "s", random_scene(2))), tmp_path / "f",
                        log=lambda *_: None, runtime="c")
     for fmu in [compiled["side_by_side"] / "side_by_side_barge_a.fmu", conv / "random2_a.fmu",
-                conv / "random2_a_b_dynamics.fmu", conv / "random2_hitch.fmu"]:
+                conv / "random2_a_b_dynamics.fmu", conv / "random2_hitch.fmu", wave_builds["irregular"] / "waves_cyl2.fmu"]:
         unzipped = tmp_path / fmu.stem
         with zipfile.ZipFile(fmu) as z:
             z.extractall(unzipped)
