@@ -53,12 +53,13 @@ print(json.dumps({"startup_s": t1 - t0, "step_s": (t2 - t1) / max(steps, 1), "fr
 SCENE = '''import json, sys, time
 from hydrofmu.cosim import libcosim, master
 engine, folder, step, n1, n2 = sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
+record = sys.argv[6].split(",") if len(sys.argv) > 6 else None   # default: every output
 run = libcosim.run if engine == "libcosim" else lambda *a, **k: master.run(*a, progress=False, **k)
-run(folder, stop=step, step=step, algorithm="jacobi")   # the process's first load: imports, unzipping
+run(folder, stop=step, step=step, algorithm="jacobi", record=record)   # the process's first load: imports, unzipping
 t = []
 for n in (n1, n2):
     t0 = time.perf_counter()
-    run(folder, stop=n * step, step=step, algorithm="jacobi")
+    run(folder, stop=n * step, step=step, algorithm="jacobi", record=record)
     t.append(time.perf_counter() - t0)
 per_step = (t[1] - t[0]) / (n2 - n1)
 print(json.dumps({"step_s": per_step, "startup_s": t[0] - n1 * per_step}))
@@ -140,17 +141,18 @@ def _row(label, t):
             "startup_noisy": spread(start_x) > NOISY}
 
 
-def compare_scene(folder, rounds=5, steps=2000):
+def compare_scene(folder, rounds=5, steps=2000, record=None):
     """A built scene (its folder) run with Jacobi exchanges by libcosim (libcosimpy: the FMUs
     are called from libcosim's C++ worker threads, which Python does not know) and by our fmpy
     master, every output recorded by both, in rounds of fresh processes.  The cost per step is
     the marginal cost between runs of 10 and ``steps`` steps, the startup what is left of the
-    short run (a run after the process's first).  Row {label, step_us, step_fmpy_us, step_x,
+    short run (a run after the process's first).  ``record``: the 'instance.variable' columns
+    both record (default every output).  Row {label, step_us, step_fmpy_us, step_x,
     step_spread, step_noisy, startup_s, startup_fmpy_s, startup_x, startup_spread, startup_noisy}."""
     step = json.loads((Path(folder) / "manifest.json").read_text())["run"]["step"]
     t = []
     for _ in range(rounds):
-        got = [_json([sys.executable, "-c", SCENE, engine, str(folder), repr(step), "10", str(steps)])
-               for engine in ("fmpy", "libcosim")]
+        got = [_json([sys.executable, "-c", SCENE, engine, str(folder), repr(step), "10", str(steps)]
+                     + ([",".join(record)] if record else [])) for engine in ("fmpy", "libcosim")]
         t.append([got[0]["step_s"], got[1]["step_s"], got[0]["startup_s"], got[1]["startup_s"]])
     return _row(f"{Path(folder).name} in libcosim", t)
