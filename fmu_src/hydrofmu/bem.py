@@ -141,7 +141,8 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
         rad = transform(data.omega, data.added_mass[sel], data.damping[sel],
                         None if data.a_inf is None else data.a_inf[np.ix_(keep, keep)],
                         units=[k >= 4 for _, k in kept], timdel=timdel, length=length, symmetry_tol=symmetry_tol,
-                        labels=[label(bodies[b], k) for b, k in kept], a_inf_from=a_inf_from)
+                        labels=[label(bodies[b], k) for b, k in kept], a_inf_from=a_inf_from,
+                        groups=[data.bodies.index(b) for b, _ in kept])
     except AsymmetryError as exc:
         i, j = exc.pair
         raise InputError(path, None, f"added_mass[inf][{label(*kept[i])}, {label(*kept[j])}]",

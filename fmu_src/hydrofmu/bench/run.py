@@ -21,7 +21,9 @@ Parts (each also callable alone, see ``PARTS``):
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
 - waves: the `waves` effect's cost per step against the pythonfmu floor for 50, 200 and
-  1000 components, and per 100 components (``waves_cost``)
+  1000 components, and per 100 components (``waves_cost``); the floating cylinder's and the
+  pair's motions in regular waves next to their lightly damped resonances, long runs at
+  several steps, against the frequency domain (``waves_motions``)
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
   case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
   took against the bonds' power (``ecco_cost``)
@@ -508,6 +510,12 @@ def part_waves(out, quick):
                  + f"; linear: {slope:.1f} µs per 100 components (cost per component at {rows[-1]['components']} / "
                  f"at {rows[0]['components']}: {ratio:.2f}); the kernel alone "
                  + ", ".join(f"{r['kernel_per_100_us']:.1f}" for r in rows) + " µs per 100 components")
+    from . import waves_motions
+    motions = waves_motions.measure(out / "waves_motions", quick)
+    if motions:
+        write_csv(out / "waves_motions.csv", motions)
+        lines += ["motions in regular waves, radiation damping only, against X(ω) of the dataset (% of each dof's "
+                  "peak |X|): " + line for line in waves_motions.summary(motions)]
     return lines
 
 
