@@ -346,7 +346,7 @@ static void load_step(Instance *inst, double t, double dt) {
         if (c->memory.kind && memory_commit(&c->memory, inst->values + c->velocity, dt))
             hf_set_error(inst, "out of memory in the retardation memory");
     }
-    inst->stale = L->ncouplings > 0 || L->waves;   /* memory and wave outputs move with time */
+    if (L->ncouplings > 0 || L->waves) inst->stale = 1;   /* memory and wave outputs move with time */
 }
 
 static size_t load_state_size(const Instance *inst) {
