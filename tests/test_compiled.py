@@ -784,3 +784,19 @@ def test_nonfinite_output_fails_the_step_that_made_it(compiled, tmp_path, capfd)
     assert np.isfinite(s.getReal([refs["force[1]"]])).all()
     s.terminate()
     s.freeInstance()
+
+
+def test_wave_fmus_model_description_is_the_python_flavours(wave_builds, tmp_path):
+    """A load FMU with waves and hydrostatics (and its dynamics partner): the same variables
+    (the waves.* parameters included), units, start values and dependencies in both flavours."""
+    from hydrofmu.fmi.build import build_scene
+    from hydrofmu.scene import load_scene
+    bem, bodies, waves, method, _ = WAVE_SCENES["regular"]
+    scene = load_scene(wave_scene(tmp_path, Path(__file__).parent / "data" / "bem" / bem, bodies, waves, method))
+    python = build_scene(scene, tmp_path / "py", log=lambda *_: None, runtime="python")
+    for fmu in sorted(python.glob("*.fmu")):
+        with zipfile.ZipFile(fmu) as a, zipfile.ZipFile(wave_builds["regular"] / fmu.name) as b:
+            ours, theirs = variables(a.read("modelDescription.xml")), variables(b.read("modelDescription.xml"))
+            assert ours == theirs, fmu.name
+            if "dynamics" not in fmu.name:
+                assert {"waves.height", "waves.period", "waves.phase", "waves.direction"} <= {r[0] for r in ours[0]}
