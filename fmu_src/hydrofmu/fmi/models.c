@@ -286,8 +286,8 @@ static void load_evaluate(Instance *inst) {
     inst->changed = 0;
     double *v = inst->values, total[6] = {0}, out[6], m6[36], extra[6];
     HfMotion m;
-    motion_of(inst, &L->motion, &m);
-    const HfEnv *env = env_now(inst, &L->env);
+    const HfEnv *env = NULL;
+    if (inputs_set && L->neffects) motion_of(inst, &L->motion, &m), env = env_now(inst, &L->env);
     for (int k = 0; k < L->neffects && inputs_set; k++) {   /* BodyLoads.effect_loads */
         const Effect *e = &L->effects[k];
         if (e->kind == HYDROSTATICS) {
