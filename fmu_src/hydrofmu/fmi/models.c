@@ -286,8 +286,8 @@ static void load_evaluate(Instance *inst) {
     inst->changed = 0;
     double *v = inst->values, total[6] = {0}, out[6], m6[36], extra[6];
     HfMotion m;
-    motion_of(inst, &L->motion, &m);
-    const HfEnv *env = env_now(inst, &L->env);
+    const HfEnv *env = NULL;
+    if (inputs_set && L->neffects) motion_of(inst, &L->motion, &m), env = env_now(inst, &L->env);
     for (int k = 0; k < L->neffects && inputs_set; k++) {   /* BodyLoads.effect_loads */
         const Effect *e = &L->effects[k];
         if (e->kind == HYDROSTATICS) {
@@ -346,7 +346,7 @@ static void load_step(Instance *inst, double t, double dt) {
         if (c->memory.kind && memory_commit(&c->memory, inst->values + c->velocity, dt))
             hf_set_error(inst, "out of memory in the retardation memory");
     }
-    inst->stale = L->ncouplings > 0 || L->waves;   /* memory and wave outputs move with time */
+    if (L->ncouplings > 0 || L->waves) inst->stale = 1;   /* memory and wave outputs move with time */
 }
 
 static size_t load_state_size(const Instance *inst) {
