@@ -379,10 +379,14 @@ def test_bad_sea_states_are_one_error_exit_2(folder, tmp_path, case):
     assert cli.main(["build", str(path), "-o", str(out)]) == 2 and not out.exists()
 
 
+MASS_ONE = float(xr.load_dataset(ONE)["inertia_matrix"].values[0, 0])
+
+
 def test_bad_datasets_are_one_error_exit_2(folder, tmp_path):
     """A dataset without excitation, NaN in the transfer function, bodies where the scene
-    does not put them, and a hydrostatic restoring counted twice: each one error naming the
-    file and the field, exit 2, nothing written."""
+    does not put them, a hydrostatic restoring counted twice, a mass or centre of mass that
+    disagrees with the dataset's: each one error naming the file and the field, exit 2,
+    nothing written."""
     from hydrofmu import cli
     shutil.copy(DATA / "cylinders.nc", folder / "radiation_only.nc")
     ds = xr.load_dataset(ONE)
@@ -398,6 +402,11 @@ def test_bad_datasets_are_one_error_exit_2(folder, tmp_path):
         (scene_text(ONE, {"cyl": 5.0}, [0.0] * 6, REGULAR, radiation=False), "wave_cylinder.nc", "rotation_center"),
         (scene_text(ONE, {"cyl": 0.0}, [0.0, 0.0, 1e5, 0.0, 0.0, 0.0], REGULAR, radiation=False).replace(
             "damping = [0.0, 0.0, 100000.0", "stiffness = [0.0, 0.0, 100000.0"), "wave_cylinder.nc", "twice"),
+        # the dataset's mass (its restoring's weight terms) 5 % off the scene's; its centre of mass 0.5 m off
+        (scene_text(ONE, {"cyl": 0.0}, [0.0] * 6, REGULAR, radiation=False).replace(
+            f"mass = {MASS_ONE!r}", f"mass = {1.05 * MASS_ONE!r}"), "wave_cylinder.nc", "bodies.cyl.mass"),
+        (scene_text(ONE, {"cyl": 0.0}, [0.0] * 6, REGULAR, radiation=False).replace(
+            "cog = [0.0, 0.0, -3.0]", "cog = [0.0, 0.0, -2.5]"), "wave_cylinder.nc", "center_of_mass"),
     ]
     for k, (text, file, words) in enumerate(cases):
         path = write_scene(folder, text, f"bad_data{k}")

@@ -428,7 +428,7 @@ ALGORITHMS = ("jacobi", "gauss-seidel", "ecco")
 ECCO_DEFAULTS = {"rel_tolerance": 1e-3, "abs_tolerance": 1.0, "min_step": 0.005, "max_step": 0.2,
                  "safety_factor": 0.8, "min_change_rate": 0.2, "max_change_rate": 1.5,
                  "p_gain": 0.2, "i_gain": 0.15}
-MEMORY_DEFAULTS = {"method": "convolution", "tolerance": 0.01, "memory_length": None}
+MEMORY_DEFAULTS = {"method": "convolution", "tolerance": 0.002, "memory_length": None}   # tolerance: see docs/bem.md (coarse grids)
 
 # Speed/accuracy presets a scene names with [run] preset = "…": each sets the run knobs
 # and the default memory evaluator of every coupling; knobs the scene sets still win.

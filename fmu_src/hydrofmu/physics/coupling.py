@@ -43,7 +43,7 @@ class Coupling:
     shared by both sides.
     """
 
-    def __init__(self, added_mass, timdel=None, kernels=None, method="convolution", tol=0.01, order=None,
+    def __init__(self, added_mass, timdel=None, kernels=None, method="convolution", tol=0.002, order=None,
                  memory_length=None, v0_a=None, v0_b=None, *, own=False, name="", bodies=("A", "B"), fits=None):
         self.name, (self.body_a, self.body_b) = name, bodies
         self.self_coupling = own

@@ -289,7 +289,7 @@ def _assemble(poles):
     return a
 
 
-def realise(h, timdel, tol=0.01, order=None, max_order=40):
+def realise(h, timdel, tol=0.002, order=None, max_order=40):
     """Realise a sampled kernel h(k·TIMDEL), k = 0…N−1, as h(t) ≈ C·exp(A·t)·B.
 
     The kernel is zero after its last sample (the convention ``Convolution`` follows), so
@@ -391,7 +391,7 @@ class StateSpace:
     (the last 16).
     """
 
-    def __init__(self, kernels, timdel, shape=None, v0=None, tol=0.01, order=None,
+    def __init__(self, kernels, timdel, shape=None, v0=None, tol=0.002, order=None,
                  max_order=40, memory_length=None, fits=None):
         self.shape, elems = _elements(kernels, shape)
         fits = dict(fits or {})
