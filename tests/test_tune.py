@@ -36,8 +36,9 @@ def recorded(cache, setting):
 
 
 def error(t, y, tf, yf):
-    """√mean((y − y_fine)²) / ptp(y_fine), largest over the columns: computed here, from the fine run."""
-    ref = yf[np.rint(t / (tf[1] - tf[0])).astype(int)]
+    """√mean((y − y_fine)²) / ptp(y_fine) at the run's points t (the fine run linear between its
+    2.5 ms points: an ECCO run's points are its own), largest over the columns: computed here."""
+    ref = np.column_stack([np.interp(t, tf, col) for col in yf.T])
     return float(np.max(np.sqrt(np.mean((y - ref) ** 2, axis=0)) / np.ptp(yf, axis=0)))
 
 
@@ -66,6 +67,24 @@ def test_tune_meets_the_tolerance_at_no_more_cost_than_a_preset(name, tmp_path):
                 assert found.choice.cost <= p.cost * (1 + spread) or found.choice.proxy <= p.proxy, (p.source, tol)
         text = "\n".join(found.report())
         assert "choice" in text and "not tried" in text and "ECCO" in text
+        # ECCO and the coupling orders: searched (ECCO run in libcosim where it can pay, its
+        # points' errors measured like every point's) or said why not, with the numbers
+        eccos = [p for p in found.points if p.setting.algorithm == "ecco"]
+        if eccos:
+            assert "ECCO (libcosim, steps 0.005–" in text and all(np.isfinite(p.error) for p in eccos), text
+            t, y = recorded(cache, eccos[0].setting)
+            assert abs(error(t, y[:, keep], *fine) - eccos[0].error) < 0.05 * eccos[0].error + 2e-4
+        else:
+            assert "ECCO: pruned, it cannot pay" in text, text
+        searched.add((name, tol, bool(eccos)))
+        ordered = {i for p in found.points for i, _ in p.setting.orders}
+        assert ordered == ({0, 1, 2} if name == "side_by_side" else set()), text
+        assert text.count("order of couplings[") == (3 if name == "side_by_side" else 0), text
+    if name == "side_by_side":   # the tight tolerance needs a small step: ECCO could pay, and was run
+        assert (name, 0.002, True) in searched
+
+
+searched = set()
 
 
 def test_tune_writes_the_run_block_and_keeps_the_rest(tmp_path):
@@ -83,6 +102,35 @@ def test_tune_writes_the_run_block_and_keeps_the_rest(tmp_path):
     text = path.read_text()
     before, after = original.split("[run]")[0], original.split("[bodies.barge]")[1]
     assert text.startswith(before) and text.endswith(after)
+
+
+def test_write_puts_ecco_and_orders_where_the_scene_reads_them(tmp_path):
+    """An ECCO choice with per-coupling orders (a Tuning made here, nothing run): the written
+    scene loads with exactly those knobs, [run.ecco] replaced, the scene's outputs and other
+    couplings kept."""
+    from hydrofmu.tuning import Point, Setting, Tuning
+    shutil.copytree(MODELS / "decks", tmp_path / "decks")
+    path = tmp_path / "side_by_side.toml"
+    path.write_text((MODELS / "side_by_side.toml").read_text().replace(
+        "stop = 200.0", 'stop = 200.0\nalgorithm = "ecco"\nstep = 0.05\noutputs = ["barge_a"]\n'
+                        '[run.ecco]\nmax_step = 0.1\nrel_tolerance = 1e-4'))
+    assert load_scene(path).run["ecco"]["rel_tolerance"] == 1e-4
+    choice = Point(Setting(0.2, "ecco", "linear", 0.05, "design", ((2, 4),), 1.0), 0.001, 0.01, 100.0)
+    found = Tuning("side_by_side", 0.005, 10.0, choice.setting, 0.0, [], [], [], [choice], choice, [], "",
+                   lambda p: True, ["SELFA", "SELFB", "AB"])
+    write_run_block(path, found)
+    scene = load_scene(path)
+    assert (scene.run["algorithm"], scene.run["step"], scene.run["substep"], scene.run["stop"]) == ("ecco", 0.05, 0.05, 200.0)
+    assert scene.run["ecco"]["max_step"] == 0.2 and scene.run["ecco"]["abs_tolerance"] == 1.0
+    assert scene.run["ecco"]["rel_tolerance"] == 1e-3   # the file's [run.ecco] replaced, not merged
+    assert scene.run["outputs"] == ["barge_a"]
+    assert [(c.method, c.order) for c in scene.couplings] == [("state_space", None)] * 2 + [("state_space", 4)]
+    assert [c.tolerance for c in scene.couplings[:2]] == [0.01, 0.01]
+    found.choice = Point(Setting(0.1, "jacobi", "constant", 0.1, "design"), 0.001, 0.01, 100.0)
+    write_run_block(path, found)   # a fixed-step choice: no [run.ecco] left behind
+    scene = load_scene(path)
+    assert (scene.run["algorithm"], scene.run["step"], scene.run["load_hold"]) == ("jacobi", 0.1, "constant")
+    assert "[run.ecco]" not in path.read_text() and scene.couplings[2].order == 4
 
 
 def test_tune_refuses_bad_input():

@@ -270,7 +270,8 @@ def tune(args):
         return 1
     if args.write:
         write_run_block(args.scene, found)
-        print(f"wrote the [run] block into {args.scene}")
+        print(f"wrote the [run] block into {args.scene}"
+              + (" and the state-space orders into its [[couplings]] tables" if found.choice.setting.orders else ""))
     else:
         print("\n" + found.run_block().rstrip())
     return 0

@@ -14,22 +14,33 @@
    communication step first), then the cheapest memory evaluator (the presets' state-space
    fits, coarsest first).  A branch whose best possible cost (its largest step, one substep,
    no memory) cannot beat the best point found so far is not refined (pruned).
+   Then, on the best point only: per coupling, a state-space order of ``ORDERS`` (fewer
+   states than its tolerance fit's largest element order; any order where the point uses the
+   full convolution), lowest first; and ECCO (libcosim's adaptive Jacobi step, steps
+   ``ECCO_MIN`` s up to the largest searched step within 4× the best point's, abs_tolerance
+   of ``ECCO_TOLERANCES``, loosest first), only where it can pay: the scene has power bonds and ECCO's fewest steps
+   (all at its largest) cost less than the best point.  ECCO runs in libcosim on FMUs built
+   for it (once per tune); its cost is converted to this process's by a fixed-step Jacobi
+   run of the same step in both (median ratio of the timing rounds).
 3. The presets and the scene's own settings, run the same way, and the final candidates
    re-timed in ``repeats`` interleaved rounds: cost = median seconds of stepping per
    simulated second (initialisation excluded), spread = (max − min) / median.
 
 Error of a run: the largest, over the named outputs (default: every body's position and
-attitude), of the RMS difference to the reference at the run's communication points over
-the reference's range (max − min): ``√mean((y − y_ref)²) / ptp(y_ref)``; outputs whose range
+attitude), of the RMS difference to the reference (linear between its points, 2.5 ms or
+finer) at the run's communication points over the reference's range (max − min):
+``√mean((y − y_ref)²) / ptp(y_ref)``; outputs whose range
 is below 1e-9 of the largest of the same unit do not move and are left out (listed).  A
 point meets the tolerance when error + u ≤ tolerance.
 
-What is searched is what a scene's ``[run]`` block can say: ``step``, ``algorithm``,
-``load_hold``, ``substep`` and, for the memory of every coupling, the evaluator of a preset
-(``preset = "reference"``: full convolution; ``"design"``: state-space tol 0.01;
-``"screening"``: tol 0.05).  Not searched: per-coupling orders and memory lengths, couplings
-that set their own ``method`` (kept as they are), and ECCO (libcosim's adaptive step runs
-only through the built FMUs; use ``hydrofmu bench --part ecco``).
+What is searched is what a scene's ``[run]`` block (with ``[run.ecco]``) and its
+``[[couplings]]`` tables can say: ``step``, ``algorithm`` (ECCO with ``max_step`` and
+``abs_tolerance``), ``load_hold``, ``substep``, for the memory of every coupling the
+evaluator of a preset (``preset = "reference"``: full convolution; ``"design"``: state-space
+tol 0.01; ``"screening"``: tol 0.05), and per coupling a state-space ``order``.  Not
+searched (listed in every report): memory lengths, couplings that set their own ``method``
+(kept as they are), ECCO's other settings (min_step, rel_tolerance, gains) and the
+``adaptive`` preset as a point of its own.
 """
 from __future__ import annotations
 
@@ -53,31 +64,54 @@ MEMORY = {"screening": "state-space tol 0.05", "design": "state-space tol 0.01",
 ALGORITHMS = ("gauss-seidel", "jacobi")
 HOLDS = ("linear", "constant")
 WINDOW = 60.0   # default tuning window [s]: the first minute of the scene's run
+ORDERS = (1, 2, 4, 8)               # per-coupling state-space orders tried (ERA order per kernel element)
+ECCO_TOLERANCES = (10.0, 1.0, 0.1)  # ECCO's abs_tolerance [J] tried, loosest (fewest steps) first
+ECCO_MIN, ECCO_FIRST = 0.005, 0.05  # ECCO's smallest and first step [s]
 
 
 @dataclass(frozen=True)
 class Setting:
     """One combination of run knobs; ``memory``: the preset whose memory evaluator every
-    coupling uses (None: the scene has no coupling to tune)."""
+    coupling uses (None: the scene has no coupling to tune); ``orders``: ((coupling index,
+    state-space order), …) over it; ``ecco``: ECCO's abs_tolerance [J] when ``algorithm`` is
+    'ecco' (``step`` is then its largest step)."""
     step: float
     algorithm: str
     load_hold: str
     substep: float
     memory: str | None
+    orders: tuple = ()
+    ecco: float | None = None
 
     def label(self) -> str:
-        return (f"step {self.step:g} s, {self.algorithm}, {self.load_hold} hold, substep {self.substep:g} s"
-                + (f", {MEMORY[self.memory]}" if self.memory else ""))
+        how = (f"ECCO steps {ECCO_MIN:g}–{self.step:g} s, abs tol {self.ecco:g} J" if self.algorithm == "ecco"
+               else f"step {self.step:g} s, {self.algorithm}")
+        return (f"{how}, {self.load_hold} hold, substep {self.substep:g} s"
+                + (f", {MEMORY[self.memory]}" if self.memory else "")
+                + "".join(f", couplings[{i}] order {n}" for i, n in self.orders))
+
+    def first_step(self) -> float:
+        """The run's ``step``: ECCO's first step, else the communication step."""
+        return min(ECCO_FIRST, self.step) if self.algorithm == "ecco" else self.step
 
     def overrides(self, stop: float) -> dict:
-        out = {"run.step": self.step, "run.algorithm": self.algorithm, "run.load_hold": self.load_hold,
+        out = {"run.step": self.first_step(), "run.algorithm": self.algorithm, "run.load_hold": self.load_hold,
                "run.substep": self.substep, "run.stop": stop}
         if self.memory:
             out["run.preset"] = self.memory
+        if self.algorithm == "ecco":
+            out["run.ecco"] = {"min_step": ECCO_MIN, "max_step": self.step, "abs_tolerance": self.ecco}
+        for i, n in self.orders:
+            out[f"couplings[{i}].method"] = "state_space"
+            out[f"couplings[{i}].order"] = n
         return out
 
-    def proxy(self, window: float, instances: int) -> float:
-        """Deterministic cost proxy: FMU steps plus the dynamics' Runge–Kutta steps over the window."""
+    def proxy(self, window: float, instances: int, time_=None) -> float:
+        """Deterministic cost proxy: FMU steps plus the dynamics' Runge–Kutta steps over the
+        window (an ECCO run: over the steps it took, ``time_``)."""
+        if time_ is not None and len(time_) > 1:
+            h = np.diff(time_)
+            return float(np.sum(instances + np.maximum(1, np.ceil(h / self.substep - 1e-9))))
         return window / self.step * (instances + max(1, round(self.step / self.substep)))
 
 
@@ -108,9 +142,13 @@ class Tuning:
     not_tried: list
     equivalence: str
     feasible: Callable = None
+    couplings: list = field(default_factory=list)   # coupling names, by index
+    searched: list = field(default_factory=list)    # lines: what the order and ECCO searches ran
 
-    def run_block(self) -> str:
-        """The ``[run]`` block of the choice (the scene's ``stop`` kept)."""
+    def run_block(self, stop: float | None = None, keep: Sequence[str] = ()) -> str:
+        """The ``[run]`` block of the choice (with ``stop`` when given, and ``[run.ecco]`` for
+        an ECCO choice, and the lines ``keep``); per-coupling orders as comments naming the
+        ``[[couplings]]`` keys."""
         if self.choice is None:
             raise ValueError("no setting met the tolerance")
         s = self.choice.setting
@@ -119,8 +157,17 @@ class Tuning:
                  "[run]"]
         if s.memory:
             lines.append(f'preset = "{s.memory}"   # memory evaluator: {MEMORY[s.memory]}')
-        lines += [f"step = {s.step!r}", f'algorithm = "{s.algorithm}"', f'load_hold = "{s.load_hold}"',
-                  f"substep = {s.substep!r}"]
+        lines += [f"step = {s.first_step()!r}" + ("   # ECCO's first step" if s.algorithm == "ecco" else ""),
+                  f'algorithm = "{s.algorithm}"', f'load_hold = "{s.load_hold}"', f"substep = {s.substep!r}"]
+        if stop is not None:
+            lines.append(f"stop = {stop!r}")
+        lines += list(keep)
+        if s.algorithm == "ecco":
+            lines += ["[run.ecco]", f"min_step = {ECCO_MIN!r}", f"max_step = {s.step!r}",
+                      f"abs_tolerance = {s.ecco!r}"]
+        for i, n in s.orders:
+            lines.append(f'# [[couplings]] #{i} ({self.couplings[i]}): method = "state_space", order = {n}'
+                         + ("" if stop is None else "   (written into that table)"))
         return "\n".join(lines) + "\n"
 
     def table(self) -> str:
@@ -140,8 +187,8 @@ class Tuning:
                  f"{100 * self.uncertainty:.2g} %, counted against every point)",
                  f"outputs ({len(self.outputs)}): {_short(self.outputs)}"
                  + (f"; left out (not moving): {_short(self.still)}" if self.still else ""),
-                 f"searched {sum(p.source == 'search' for p in self.points)} points; {self.equivalence}",
-                 self.table()]
+                 f"searched {sum(p.source == 'search' for p in self.points)} points; {self.equivalence}"]
+        lines += self.searched + [self.table()]
         if self.choice is None:
             lines.append("no setting met the tolerance: loosen it or lengthen the window")
         else:
@@ -162,15 +209,18 @@ def _short(names, show=6):
 
 
 class _Runner:
-    """Runs settings of one scene in this process over the window; caches errors."""
+    """Runs settings of one scene in this process over the window (ECCO: in libcosim, on FMUs
+    built for it once)."""
 
     def __init__(self, path, window, outputs, log):
-        from .scene import load_scene
         self.path, self.window, self.log = Path(path), window, log
         self.outputs, self.manifest, self.instances = outputs, None, 0
+        self.builds, self.ratios, self._tmp = {}, [], None
 
     def run(self, setting: Setting):
         """(times, values of the columns, seconds of stepping)."""
+        if setting.algorithm == "ecco":
+            return self.run_ecco(setting)
         from .cosim import inprocess
         from .cosim.master import run
         from .scene import load_scene
@@ -199,10 +249,48 @@ class _Runner:
         seconds = marks[n] - marks[1] if n > 1 else float("nan")
         return result.time, result.values, seconds * n / max(n - 1, 1)
 
+    def built(self, setting: Setting):
+        """The FMUs of an ECCO setting (one build per setting but its abs_tolerance, a run knob)."""
+        import tempfile
+        from .fmi.build import build_scene
+        from .scene import load_scene
+        key = replace(setting, ecco=1.0)
+        if key not in self.builds:
+            if self._tmp is None:
+                self._tmp = tempfile.TemporaryDirectory(prefix="hydrofmu-tune-")
+            scene = load_scene(self.path, key.overrides(self.window))
+            scene.run["interval"] = None   # every point ECCO takes is compared
+            self.builds[key] = build_scene(scene, Path(self._tmp.name) / str(len(self.builds)), log=lambda *_: None)
+        return self.builds[key]
+
+    def run_ecco(self, setting: Setting):
+        """An ECCO run in libcosim: (its time points up to the window, values, seconds of
+        stepping converted to this process's by the latest Jacobi calibration ``ratios``)."""
+        from .cosim import libcosim
+        clock = {}
+        try:
+            r = libcosim.run(self.built(setting), stop=self.window, algorithm="ecco", record=self.columns,
+                             ecco={"abs_tolerance": setting.ecco}, timing=clock)
+        except RuntimeError as exc:
+            return None, str(exc), float("nan")
+        keep = r.time <= self.window + 1e-9
+        return r.time[keep], r.values[keep, :len(self.columns)], clock["stepping"] * self.ratios[-1]
+
+    def calibrate(self, ecco: Setting, jacobi: Setting):
+        """A fixed-step Jacobi run of ``jacobi`` (ECCO's hold, substep and memory) in libcosim on
+        the build of ``ecco`` and in this process, timed back to back: appends the ratio of
+        their seconds of stepping (this process / libcosim)."""
+        from .cosim import libcosim
+        clock = {}
+        libcosim.run(self.built(ecco), stop=self.window, step=jacobi.step, algorithm="jacobi", record=self.columns,
+                     timing=clock)
+        self.ratios.append(self.run(jacobi)[2] / clock["stepping"])
+
 
 def _error(time_, values, ref_time, ref_values, scale):
-    idx = np.rint(time_ / (ref_time[1] - ref_time[0])).astype(int)
-    ref = ref_values[idx]
+    """Largest normalised RMS difference at ``time_`` (the reference linear between its points:
+    exact at a fixed-step run's points, which lie on its grid)."""
+    ref = np.column_stack([np.interp(time_, ref_time, col) for col in ref_values.T])
     return float(np.max(np.sqrt(np.mean((values - ref) ** 2, axis=0)) / scale))
 
 
@@ -297,7 +385,9 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
             err = math.inf if t is None else _error(t, y[:, moving], ref_time, ref_values, scale)
             if not math.isfinite(err):
                 err = math.inf
-            points[setting] = Point(setting, err, sec / window, setting.proxy(window, runner.instances), source=source)
+            points[setting] = Point(setting, err, sec / window,
+                                    setting.proxy(window, runner.instances, t if setting.algorithm == "ecco" else None),
+                                    source=source)
         elif source != "search":
             old = points[setting].source
             points[setting].source = source if old == "search" else f"{old} = {source}"
@@ -345,6 +435,12 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
                     break
             if best is None or chosen.proxy < best.proxy or (chosen.proxy == best.proxy and chosen.cost < best.cost):
                 best = chosen
+    searched = []
+    if best is not None and has_memory:
+        best = _search_orders(own, path, window, best, point, feasible, searched)
+    ecco_pruned = None
+    if best is not None:
+        ecco_pruned = _search_ecco(runner, window, best, point, feasible, searched)
     # the presets and the scene's own settings
     from .scene import PRESETS
     for name in ("screening", "design", "reference"):
@@ -363,7 +459,10 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
         cheapest = min(p.proxy for p in ok)
         finalists = sorted((p for p in ok if p.proxy <= 2 * cheapest), key=lambda p: p.proxy)[:4]
         finalists += [p for p in points.values() if p.source != "search" and p not in finalists]
+        eccos = [p for p in finalists if p.setting.algorithm == "ecco"]
         for _ in range(max(1, repeats)):
+            if eccos:   # ECCO's cost in this process's seconds: a calibration pair per round
+                runner.calibrate(eccos[0].setting, runner.calibration)
             for p in finalists:
                 if math.isfinite(p.error):
                     p.times.append(runner.run(p.setting)[2] / window)
@@ -373,8 +472,11 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
             p.cost = float(np.median(p.times))
             p.spread = float(np.ptp(p.times) / p.cost) if len(p.times) > 1 and p.cost > 0 else None
         choice = min((p for p in finalists if feasible(p)), key=lambda p: (p.cost, p.proxy))
-    not_tried = ["ECCO (libcosim's adaptive step runs only through the built FMUs: hydrofmu bench --part ecco)",
-                 "per-coupling state-space orders and memory lengths",
+    not_tried = ([ecco_pruned] if ecco_pruned else []) + [
+                 "ECCO's min_step, rel_tolerance and controller gains (kept at "
+                 f"{ECCO_MIN:g} s and libcosim's defaults), and the 'adaptive' preset as a point of its own",
+                 f"state-space orders other than {', '.join(map(str, ORDERS))}, orders on any point but the best, "
+                 "and memory lengths",
                  f"steps outside {', '.join(f'{s:g}' for s in steps)} s (steps must divide the window "
                  f"{window:g} s and the scene's stop {stop:g} s)"]
     if own.couplings and any(c.set for c in own.couplings):
@@ -383,11 +485,73 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
     tuning = Tuning(own.name, tolerance, window, half, u, list(np.array(runner.columns)[moving]), runner.columns, still,
                     list(points.values()), choice, not_tried,
                     "runs in this process (cosim.inprocess: the FMUs' slaves and the fmpy master's loop, "
-                    "the same numbers as the built FMUs without the FMI calls; costs are this process's)",
-                    feasible)
+                    "the same numbers as the built FMUs without the FMI calls; costs are this process's)"
+                    + ("; ECCO in libcosim on built FMUs, its cost in this process's seconds" if runner.ratios else ""),
+                    feasible, [c.name for c in own.couplings], searched)
     if png:
         plot(tuning, png)
     return tuning
+
+
+def _search_orders(scene, path, window, best, point, feasible, searched):
+    """Per coupling that does not set its own method, on the best point: a state-space order of
+    ``ORDERS``, lowest first, with fewer states than the coupling's evaluator there (its
+    tolerance fit's largest element order; any order in place of the full convolution); the
+    first that meets the tolerance is kept.  Returns the best point, with the orders kept."""
+    from .scene import load_scene
+    tuned = [i for i, c in enumerate(scene.couplings) if not c.set and c.kernels]
+    fitted = load_scene(path, {"run.preset": best.setting.memory, "run.stop": window}) if tuned else None
+    for i in tuned:
+        c = fitted.couplings[i]
+        if c.method == "state_space":
+            largest = max(f.order for f in c.model().fits.values())
+            ladder = [n for n in ORDERS if n < largest]
+            why = f"tol {c.tolerance:g} fit, largest element order {largest}"
+        else:
+            ladder, why = list(ORDERS), "full convolution"
+        tried = []
+        for n in ladder:
+            p = point(replace(best.setting, orders=best.setting.orders + ((i, n),)))
+            tried.append(f"{n}: {100 * p.error:.3g} %" + ("" if feasible(p) else " (fails)"))
+            if feasible(p):
+                best = p
+                break
+        searched.append(f"order of couplings[{i}] ({c.name}; {why}): "
+                        + ("; ".join(tried) if tried else "no smaller order to try"))
+    return best
+
+
+def _search_ecco(runner, window, best, point, feasible, searched):
+    """ECCO on the best point's hold, substep and memory, where it can pay: abs_tolerance of
+    ``ECCO_TOLERANCES``, loosest first, until one meets the tolerance or takes more steps
+    than the best point.  Returns why it was not tried, or None."""
+    from .cosim.bonds import power_bonds
+    if not power_bonds(runner.manifest):
+        return "ECCO: not applicable (no power bonds: a load FMU's force to a dynamics FMU and its velocity back)"
+    # ECCO's largest step: the largest searched one up to 4x the best point's (a joint's default
+    # spring follows the largest step: one for 1 s steps is another joint than the reference's)
+    top = max([s for s in STEPS if s <= min(window / 2, 4 * best.setting.step)] or [best.setting.step])
+    floor = Setting(top, "jacobi", best.setting.load_hold, top, None).proxy(window, runner.instances)
+    if floor >= best.proxy:
+        return (f"ECCO: pruned, it cannot pay (its fewest steps, all {top:g} s with one Runge–Kutta step each, "
+                f"cost {floor:.0f} step units, the best point {best.proxy:.0f}: {best.setting.label()})")
+    base = replace(best.setting, step=top, algorithm="ecco", ecco=ECCO_TOLERANCES[0])
+    runner.calibration = replace(best.setting, algorithm="jacobi")
+    runner.calibrate(base, runner.calibration)
+    tried = []
+    for tol in ECCO_TOLERANCES:
+        p = point(replace(base, ecco=tol))
+        tried.append(f"abs_tolerance {tol:g} J: {100 * p.error:.3g} %{'' if feasible(p) else ' (fails)'}, "
+                     f"{p.proxy:.0f} step units")
+        if feasible(p):
+            break
+        if p.proxy >= best.proxy and tol != ECCO_TOLERANCES[-1]:
+            tried.append("tighter tolerances take more steps than the best point: stopped")
+            break
+    searched.append(f"ECCO (libcosim, steps {ECCO_MIN:g}–{top:g} s; best fixed point {best.proxy:.0f} step units; "
+                    f"its cost × {runner.ratios[-1]:.2g}, this process's over libcosim's seconds for "
+                    f"{runner.calibration.label()}): " + "; ".join(tried))
+    return None
 
 
 def _divides(small, big):
@@ -419,10 +583,10 @@ def plot(tuning: Tuning, path) -> Path:
     import matplotlib.pyplot as plt
     from .cosim.report import plain_log_ticks
     fig, ax = plt.subplots(figsize=(9.5, 5))
-    marker = {"gauss-seidel": "o", "jacobi": "s"}
+    marker = {"gauss-seidel": "o", "jacobi": "s", "ecco": "^"}
     color = {"linear": "C0", "constant": "C1"}
     pts = [p for p in tuning.points if p.cost > 0 and p.error > 0]
-    for alg in ALGORITHMS:
+    for alg in ALGORITHMS + ("ecco",):
         for hold in HOLDS:
             rs = [p for p in pts if p.setting.algorithm == alg and p.setting.load_hold == hold]
             if rs:
@@ -451,28 +615,48 @@ def plot(tuning: Tuning, path) -> Path:
 
 
 RUN_TABLE = re.compile(r"^\s*\[\s*run\s*\]\s*(#.*)?$")
+RUN_ECCO = re.compile(r"^\s*\[\s*run\s*\.\s*ecco\s*\]\s*(#.*)?$")
+COUPLING = re.compile(r"^\s*\[\[\s*couplings\s*\]\]\s*(#.*)?$")
 TABLE = re.compile(r"^\s*\[")
 
 
+def _table_end(lines, start):
+    """Index of the first line of the table after the one whose header is ``lines[start]``."""
+    return next((i for i in range(start + 1, len(lines)) if TABLE.match(lines[i])), len(lines))
+
+
 def write_run_block(scene_path, tuning: Tuning) -> Path:
-    """Replace the scene's ``[run]`` table (its ``stop`` and ``[run.ecco]`` kept out: stop kept,
-    the rest of the file untouched) by the choice; the file is checked to load before it is
-    replaced."""
+    """Replace the scene's ``[run]`` table by the choice (its ``stop``, ``outputs`` and
+    ``interval`` kept; ``[run.ecco]`` replaced by an ECCO choice's, else removed) and set the ``method``/``order`` of each coupling the choice
+    gives an order, in its ``[[couplings]]`` table; the rest of the file untouched.  The file
+    is checked to load before it is replaced."""
     from .scene import load_scene
     path = Path(scene_path)
     lines = path.read_text().splitlines(keepends=True)
-    start = next((i for i, l in enumerate(lines) if RUN_TABLE.match(l)), None)
-    block = tuning.run_block()
-    stop_line = f"stop = {load_scene(path).run['stop']!r}\n"
+    import json
+    run = load_scene(path).run
+    # what the run writes is no run knob: kept
+    block = tuning.run_block(stop=run["stop"], keep=[f"{k} = {json.dumps(run[k])}" for k in ("outputs", "interval")
+                                                     if run.get(k) is not None])
+    setting = tuning.choice.setting
+    heads = [i for i, line in enumerate(lines) if COUPLING.match(line)]
+    for i, n in sorted(setting.orders, reverse=True):   # from the end: the earlier heads stay put
+        h = heads[i]
+        end = _table_end(lines, h)
+        rest = [line for line in lines[h + 1:end] if not re.match(r"^\s*(method|order|tolerance)\s*=", line)]
+        lines[h + 1:end] = ['method = "state_space"   # hydrofmu tune\n', f"order = {n}\n"] + rest
+    e = next((i for i, line in enumerate(lines) if RUN_ECCO.match(line)), None)
+    if e is not None:   # ECCO settings are the choice's (as the tune ran them), or none
+        del lines[e:_table_end(lines, e)]
+    start = next((i for i, line in enumerate(lines) if RUN_TABLE.match(line)), None)
     if start is None:
-        first = next((i for i, l in enumerate(lines) if TABLE.match(l) and not l.strip().startswith("[scene")
-                      and not l.strip().startswith("[environment")), len(lines))
-        new = lines[:first] + [block + stop_line + "\n"] + lines[first:]
+        first = next((i for i, line in enumerate(lines) if TABLE.match(line) and not line.strip().startswith("[scene")
+                      and not line.strip().startswith("[environment")), len(lines))
+        new = lines[:first] + [block + "\n"] + lines[first:]
     else:
-        end = next((i for i in range(start + 1, len(lines)) if TABLE.match(lines[i])), len(lines))
-        kept = [l for l in lines[start + 1:end] if re.match(r"^\s*stop\s*=", l)]
-        trailing = [l for l in lines[start + 1:end] if not l.strip()]
-        new = lines[:start] + [block] + (kept or [stop_line]) + (["\n"] if trailing else []) + lines[end:]
+        end = _table_end(lines, start)
+        trailing = [line for line in lines[start + 1:end] if not line.strip()]
+        new = lines[:start] + [block] + (["\n"] if trailing else []) + lines[end:]
     tmp = path.with_name(f".{path.name}.tune")
     tmp.write_text("".join(new))
     try:

@@ -28,7 +28,8 @@ from .stream import output_every, select
 NS = 1_000_000_000
 
 
-def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None, outputs=None, interval=None):
+def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None, outputs=None, interval=None,
+        timing=None):
     """Run the scene built in ``folder`` (its manifest.json) in libcosim; returns a Result
     with the same columns and time points as cosim.master.run (default: every output of
     every FMU, every step).
@@ -39,7 +40,8 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None, ou
     ``ecco``: ECCO settings over the scene's (``{'rel_tolerance': 1e-4}``, keys of ``[run.ecco]``).
     An ECCO run's time points are the ones it chose (an output interval is refused); it
     ends at the first at or after ``stop``, and its Result records every power bond's
-    force and velocity too."""
+    force and velocity too.  ``timing``: a dict that receives ``stepping``, the seconds
+    libcosim spent stepping (loading and initialisation excluded)."""
     from libcosimpy.CosimAlgorithm import CosimAlgorithm, EccoParams
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
@@ -134,7 +136,14 @@ def run(folder, stop=None, step=None, record=None, algorithm=None, ecco=None, ou
         for b in bonds:
             for name, var in ((b.load, b.velocity), (b.dynamics, b.dyn_force)):
                 series.start_time_series(index[name], refs[name][var], CosimVariableType.REAL)
-    if not execution.simulate_until(target_time=int(round(stop * NS)) if wanted == "ecco" else n * step_ns):
+    import time as clock
+    end = int(round(stop * NS)) if wanted == "ecco" else n * step_ns
+    ok = timing is None or end <= step_ns or execution.simulate_until(target_time=step_ns)
+    started = clock.perf_counter()   # timed from the first step on (initialisation excluded)
+    ok = ok and execution.simulate_until(target_time=end)
+    if timing is not None:
+        timing["stepping"] = clock.perf_counter() - started
+    if not ok:
         from libcosimpy._internal import get_last_error_message
         why = "; ".join(line.strip() for line in get_last_error_message().splitlines() if line.strip())
         raise RuntimeError(f"libcosim stopped before the end time: {why}")
