@@ -154,3 +154,12 @@ def test_bench_lines_never_contradict_their_numbers():
     good = overhead_line({**row, "fmu_us": 37.0, "in_process_us": 23.0, "ratio": 1.6, "floor_us": 13.0,
                           "ratio_above_floor": -0.02})
     assert "1.60×" in good and "within the noise" in good and "-0.02" not in good
+    # the native part: a marginal cost per step below zero in a round (seen in a quick run:
+    # "spread -31 % > 25 %", "-3.45× fmpy per step ... met") is noise, said so
+    from hydrofmu.bench.native import _row
+    from hydrofmu.bench.run import native_line
+    for rounds in ([[60e-6, 14e-6, 0.01, 0.1], [60e-6, -4e-6, 0.01, 0.1]], [[-1e-6, 1e-5, 0.01, 0.1]] * 2):
+        line = native_line(_row("floor3 in libcosim", rounds), scene=True)
+        assert "below the noise" in line and "met" not in line and not re.search(r"-\d", line), line
+    line = native_line(_row("x", [[60e-6, 30e-6, 0.01, 0.1], [61e-6, 30e-6, 0.01, 0.1]]))
+    assert "0.50× fmpy per step" in line and "met" in line

@@ -133,9 +133,13 @@ def _row(label, t):
     """The row of one candidate from its rounds [fmpy step, native step, fmpy startup, native startup]."""
     t = np.array(t)
     step_x, start_x = t[:, 1] / t[:, 0], t[:, 3] / t[:, 2]
+    # a marginal cost per step (the difference of a short and a long run) at or below zero in
+    # some round: the difference drowned in noise, and a ratio or spread of it means nothing
+    lost = bool(np.any(t[:, :2] <= 0))
     return {"label": label, "step_us": 1e6 * float(np.median(t[:, 1])),
             "step_fmpy_us": 1e6 * float(np.median(t[:, 0])), "step_x": float(np.median(step_x)),
-            "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY or np.median(t[:, 1]) <= 0,
+            "step_lost": lost,
+            "step_spread": spread(step_x), "step_noisy": lost or spread(step_x) > NOISY,
             "startup_s": float(np.median(t[:, 3])), "startup_fmpy_s": float(np.median(t[:, 2])),
             "startup_x": float(np.median(start_x)), "startup_spread": spread(start_x),
             "startup_noisy": spread(start_x) > NOISY}

@@ -358,20 +358,27 @@ def part_native(out, quick):
     design = out / "native" / "scenes" / ("moored_barge" if quick else "side_by_side")
     scenes = [native.compare_scene(f, rounds=2 if quick else 5, steps=200 if quick else 2000) for f in (design, ring)]
     write_csv(out / "native.csv", rows + scenes)
-    lines = []
-    for r in rows + scenes:
-        step = (f"too noisy per step ({over(r['step_spread'], floor.NOISY)}), no figure" if r["step_noisy"] else
-                f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
-                f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
-        start = (f"startup {1e3 * r['startup_s']:.0f} ms native (Python started by the FMU) vs "
-                 f"{1e3 * r['startup_fmpy_s']:.0f} ms under fmpy (Python running)" if r not in scenes else
-                 f"startup of a later run {1e3 * r['startup_s']:.0f} ms vs {1e3 * r['startup_fmpy_s']:.0f} ms "
-                 f"(our fmpy master)")
-        lines.append(f"{r['label']}: {step}; {start}")
+    lines = [native_line(r, r in scenes) for r in rows + scenes]
     crashes = native.exit_crashes()
     if crashes:
         lines.append(f"{len(crashes)} timing processes died at exit after their figures: " + "; ".join(crashes[:3]))
     return lines
+
+
+def native_line(r, scene=False):
+    """One line of the native part: a row of ``native.compare`` (or ``compare_scene``: ``scene``)."""
+    if r.get("step_lost"):
+        step = "too noisy per step (a round measured no cost per step: below the noise of its runs), no figure"
+    elif r["step_noisy"]:
+        step = f"too noisy per step ({over(r['step_spread'], floor.NOISY)}), no figure"
+    else:
+        step = (f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
+                f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
+    start = (f"startup {1e3 * r['startup_s']:.0f} ms native (Python started by the FMU) vs "
+             f"{1e3 * r['startup_fmpy_s']:.0f} ms under fmpy (Python running)" if not scene else
+             f"startup of a later run {1e3 * r['startup_s']:.0f} ms vs {1e3 * r['startup_fmpy_s']:.0f} ms "
+             f"(our fmpy master)")
+    return f"{r['label']}: {step}; {start}"
 
 
 def part_startup(out, quick):
