@@ -163,3 +163,18 @@ def test_bench_lines_never_contradict_their_numbers():
         assert "below the noise" in line and "met" not in line and not re.search(r"-\d", line), line
     line = native_line(_row("x", [[60e-6, 30e-6, 0.01, 0.1], [61e-6, 30e-6, 0.01, 0.1]]))
     assert "0.50× fmpy per step" in line and "met" in line
+    # waves: a noisy scene cost and an effect below zero are not printed
+    from hydrofmu.bench.run import waves_lines
+    wave = {"components": 50, "no_waves_us": 90.0, "step_x_no_waves": 1.4, "step_us": 144.0, "step_x": 4.4,
+            "step_floor_us": 46.0, "effect_us": 12.0, "kernel_per_100_us": 10.6, "noisy": False}
+    rows = [wave, {**wave, "components": 1000, "effect_us": -3.0, "noisy": True}]
+    text = " ".join(waves_lines(rows))
+    assert "too noisy" in text and "144 µs" not in text and "below the noise" in text and "linear" not in text
+    assert not re.search(r"-\d", text), text
+    assert "linear: " in " ".join(waves_lines([wave, {**wave, "components": 1000, "effect_us": 33.0}]))
+    # the flavours in our master against the floor: noisy figures not printed
+    from hydrofmu.bench.compiled import flavour_line
+    r = {"label": "side_by_side, Python flavour", "step_us": 322.0, "step_x": 3.2, "startup_s": 0.118,
+         "startup_x": 2.88, "step_spread": 0.8, "step_noisy": True, "startup_spread": 0.1, "startup_noisy": False}
+    line = flavour_line(r, 0.05)
+    assert "322" not in line and "too noisy (spread 80 % > 25 %), no figure" in line and "118 ms" in line

@@ -127,9 +127,9 @@ def part(out, quick, pythonfmu_floor):
     lines = [f"native floor (trivial compiled FMU, C host): {f['step_floor_us']:.2f} µs per step "
              f"(set 6, doStep, get 6), startup {f['startup_floor_ms']:.2f} ms"]
 
-    def figure(r, what, text):   # (a noisy figure is printed, marked: indicative only)
-        return (text + f" [{what} too noisy: spread {100 * r[f'{what}_spread']:.0f} % > {100 * NOISY:.0f} %, "
-                       "indicative only]") if r[f"{what}_noisy"] else text
+    def figure(r, what, text):   # a noisy figure is said to be so, not printed
+        from .timing import over
+        return f"{what} too noisy ({over(r[f'{what}_spread'], NOISY)}), no figure" if r[f"{what}_noisy"] else text
 
     for r in rows:
         lines.append(f"compiled {r['label']}: " + figure(r, "step", f"{r['step_x']:.1f}× the native floor per step "
@@ -147,11 +147,7 @@ def part(out, quick, pythonfmu_floor):
     step = scene.run["step"]
     rows = floor.compare(both, pythonfmu_floor, out / "master", rounds=3 if quick else 5,
                          steps=100 if quick else 2000, step=step, best_of=1 if quick else STARTUP_BEST)
-    for r in rows:
-        lines.append(f"{r['label']} (our master, fmpy): {r['step_us']:.0f} µs per step "
-                     f"({r['step_x']:.2f}× the pythonfmu floor), real-time factor {step / (1e-6 * r['step_us']):.0f}; "
-                     f"startup {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× the floor)"
-                     + (" [noisy]" if r["step_noisy"] or r["startup_noisy"] else ""))
+    lines += [flavour_line(r, step) for r in rows]
     # the compiled design scene in libcosim (its C++ master, called through libcosimpy) against
     # our master on the same FMUs, and three native floors in a ring: libcosim's own cost
     # (every output recorded by both, and one: libcosim's time-series observer costs per variable)
@@ -161,8 +157,33 @@ def part(out, quick, pythonfmu_floor):
                                   ("side_by_side, compiled flavour, one output recorded", design, ["barge_a.force[1]"]),
                                   ("3 native floor FMUs in a ring (libcosim's own cost)", ring, None)):
         r = native.compare_scene(folder, rounds=2 if quick else 5, steps=200 if quick else 2000, record=record)
-        lines.append(f"{label} in libcosim: {r['step_us']:.0f} µs per step ({r['step_x']:.2f}× our master on the "
-                     f"same FMUs, {r['step_fmpy_us']:.0f} µs), real-time factor {step / (1e-6 * r['step_us']):.0f}; "
-                     f"startup of a later run {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× ours)"
-                     + (" [noisy]" if r["step_noisy"] or r["startup_noisy"] else ""))
+        lines.append(libcosim_line(label, r, step))
     return lines
+
+
+def flavour_line(r, step):
+    """A flavour's run in our master against the pythonfmu floor (a row of ``floor.compare``):
+    a noisy figure is said to be so, not printed."""
+    from .timing import over
+    per_step = (f"per step too noisy ({over(r['step_spread'], NOISY)}), no figure" if r["step_noisy"] else
+                f"{r['step_us']:.0f} µs per step ({r['step_x']:.2f}× the pythonfmu floor), real-time factor "
+                f"{step / (1e-6 * r['step_us']):.0f}")
+    start = (f"startup too noisy ({over(r['startup_spread'], NOISY)}), no figure" if r["startup_noisy"] else
+             f"startup {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× the floor)")
+    return f"{r['label']} (our master, fmpy): {per_step}; {start}"
+
+
+def libcosim_line(label, r, step):
+    """A scene in libcosim against our master on the same FMUs (a row of
+    ``native.compare_scene``): a noisy figure is said to be so, not printed."""
+    from .timing import over
+    if r.get("step_lost"):
+        per_step = "per step too noisy (a round measured no cost per step: below the noise of its runs), no figure"
+    elif r["step_noisy"]:
+        per_step = f"per step too noisy ({over(r['step_spread'], NOISY)}), no figure"
+    else:
+        per_step = (f"{r['step_us']:.0f} µs per step ({r['step_x']:.2f}× our master on the same FMUs, "
+                    f"{r['step_fmpy_us']:.0f} µs), real-time factor {step / (1e-6 * r['step_us']):.0f}")
+    start = (f"startup too noisy ({over(r['startup_spread'], NOISY)}), no figure" if r["startup_noisy"] else
+             f"startup of a later run {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× ours)")
+    return f"{label} in libcosim: {per_step}; {start}"

@@ -45,6 +45,7 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from . import compiled, cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust  # noqa: E402
 from . import stability, startup  # noqa: E402
+from . import waves_cost  # noqa: E402
 from .timing import over  # noqa: E402
 
 
@@ -500,22 +501,32 @@ def part_longrun(out, quick):
 
 
 def part_waves(out, quick):
-    from . import waves_cost
     rows = waves_cost.measure(out / "waves", rounds=2 if quick else 5, steps=200 if quick else 400)
     if rows is None:
         return [f"skipped: needs {waves_cost.DATA} (a repository checkout)"]
     write_csv(out / "waves.csv", rows)
-    slope, ratio = waves_cost.linear(rows)
-    noisy = any(r["noisy"] for r in rows)
-    lines = [("too noisy to trust (spread between rounds above the floor's limit): " if noisy else "")
-             + "scene per step through fmpy (load + dynamics FMU): without waves "
-             + f"{rows[0]['no_waves_us']:.0f} µs = {rows[0]['step_x_no_waves']:.2f}× the pythonfmu floor; "
-             + ", ".join(f"{r['components']} components {r['step_us']:.0f} µs = {r['step_x']:.2f}× "
-                         f"(floor {r['step_floor_us']:.0f} µs)" for r in rows)]
-    lines.append("the effect in the load FMU (in-process, with − without waves): "
-                 + ", ".join(f"{r['components']} components {r['effect_us']:.0f} µs" for r in rows)
-                 + f"; linear: {slope:.1f} µs per 100 components (cost per component at {rows[-1]['components']} / "
-                 f"at {rows[0]['components']}: {ratio:.2f}); the kernel alone "
+    return waves_lines(rows)
+
+
+def waves_lines(rows):
+    """The waves part's lines: a noisy scene cost and an effect at or below zero (the
+    difference of two timings) are said to be noise, not printed."""
+    lines = []
+    if any(r["noisy"] for r in rows):
+        lines.append(f"scene per step through fmpy (load + dynamics FMU): too noisy (spread between rounds above "
+                     f"{100 * floor.NOISY:g} %), no figure")
+    else:
+        lines.append("scene per step through fmpy (load + dynamics FMU): without waves "
+                     + f"{rows[0]['no_waves_us']:.0f} µs = {rows[0]['step_x_no_waves']:.2f}× the pythonfmu floor; "
+                     + ", ".join(f"{r['components']} components {r['step_us']:.0f} µs = {r['step_x']:.2f}× "
+                                 f"(floor {r['step_floor_us']:.0f} µs)" for r in rows))
+    effect = ", ".join(f"{r['components']} components " + (f"{r['effect_us']:.0f} µs" if r["effect_us"] > 0
+                                                           else "below the noise") for r in rows)
+    if all(r["effect_us"] > 0 for r in rows):
+        slope, ratio = waves_cost.linear(rows)
+        effect += (f"; linear: {slope:.1f} µs per 100 components (cost per component at {rows[-1]['components']} / "
+                   f"at {rows[0]['components']}: {ratio:.2f})")
+    lines.append("the effect in the load FMU (in-process, with − without waves): " + effect + "; the kernel alone "
                  + ", ".join(f"{r['kernel_per_100_us']:.1f}" for r in rows) + " µs per 100 components")
     from . import waves_motions
     motions = waves_motions.measure(out / "waves_motions", quick)
