@@ -66,6 +66,11 @@ def test_pareto_front():
     rows = pareto([{"wall_s": 1, "error": 0.1}, {"wall_s": 2, "error": 0.01}, {"wall_s": 3, "error": 0.05},
                    {"wall_s": 0.5, "error": 0.2}])
     assert [r["pareto"] for r in rows] == [True, True, False, True]
+    # equal cost, more error: dominated (the quick ECCO part marked Jacobi at 100 steps and 0.49 %
+    # Pareto beside Gauss–Seidel at 100 steps and 0.25 %); equal rows dominate neither
+    rows = pareto([{"steps": 100, "error": 0.00493}, {"steps": 100, "error": 0.00246}, {"steps": 880, "error": 5e-5},
+                   {"steps": 880, "error": 5e-5}], cost="steps")
+    assert [r["pareto"] for r in rows] == [False, True, True, True]
 
 
 def test_per_call_interleaves_and_restarts():

@@ -60,9 +60,11 @@ def step_sweep(folder, steps=(0.2, 0.1, 0.05, 0.02, 0.01), algorithms=("jacobi",
 
 
 def pareto(rows, cost="wall_s", error="error"):
-    """Mark each row ``pareto``: no other row is both cheaper and more accurate."""
+    """Mark each row ``pareto``: no other row is at least as cheap and as accurate and better in
+    one (the same step count with twice the error is dominated)."""
     for r in rows:
-        r["pareto"] = not any(o[cost] < r[cost] and o[error] < r[error] for o in rows)
+        r["pareto"] = not any(o[cost] <= r[cost] and o[error] <= r[error] and (o[cost] < r[cost] or o[error] < r[error])
+                              for o in rows)
     return rows
 
 

@@ -490,7 +490,8 @@ def part_longrun(out, quick):
     write_csv(out / "longrun.csv", rows)
     by = {r["mode"]: r for r in rows}
     s = by["stream"]
-    line = (f"{s['steps']} steps of side_by_side ({stop / 3600:g} h): streamed peak {s['peak_mb']:.0f} MB "
+    span = f"{stop / 3600:g} h" if stop >= 3600 else f"{stop / 60:g} min"
+    line = (f"{s['steps']} steps of side_by_side ({span}): streamed peak {s['peak_mb']:.0f} MB "
             f"(its plot's process {s['child_peak_mb']:.0f} MB), {s['wall_s']:.0f} s, files {s['written_mb']:.0f} MB "
             f"(Parquet + CSV + PNG)")
     if "memory" in by:
@@ -542,11 +543,25 @@ PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, 
          "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves}
 
 
+# --quick without --part: the parts whose quick size costs under ~12 s of CPU each (measured
+# 2026-11-26, 2-core machine under load: 57 s of CPU in all); the others are smoke-run alone
+# (memory 14 s, floor 15 s, batch 19 s, waves 20 s of CPU with --quick)
+QUICK = ("overhead", "sweep", "growth", "native", "startup", "stability", "bem", "robust", "ecco", "longrun")
+
+
 def main(out, parts=None, quick=False, log=print):
-    """Run the benchmark ``parts`` (default all) into folder ``out``; returns summary lines."""
+    """Run the benchmark ``parts`` (default all; with ``quick``: ``QUICK``) into folder
+    ``out``; returns summary lines."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     lines = []
+    if quick and not parts:
+        parts = QUICK
+        left = [name for name in PARTS if name not in QUICK]
+        note = (f"quick: not run: {', '.join(left)} (each alone: --part NAME --quick, 15–20 s of CPU; "
+                "all parts: without --quick)")
+        log(note)
+        lines.append(note)
     for name in parts or PARTS:
         t0 = time.perf_counter()
         log(f"bench {name} …")
