@@ -422,7 +422,8 @@ def make_parser():
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "bem",
                             "robust", "batch", "ecco", "longrun", "waves"),
                    help="run only this part (repeatable; default: all)")
-    k.add_argument("--quick", action="store_true", help="small sizes: a 1-minute smoke run, not the README figures")
+    k.add_argument("--quick", action="store_true", help="a smoke run of the cheaper parts at small sizes (about a minute of CPU; the "
+                        "parts it leaves out are named), not the documented figures")
     m = sub.add_parser("bem2simo", formatter_class=fmt,
                        help="SIMO coupling deck (A∞ and retardation functions) from a BEM result",
                        description="Turn a BEM result (Capytaine NetCDF, WAMIT .1) into a SIMO deck with every self "
