@@ -592,6 +592,10 @@ def plot(tuning: Tuning, path) -> Path:
             if rs:
                 ax.loglog([p.cost for p in rs], [100 * p.error for p in rs], marker[alg], color=color[hold],
                           alpha=0.7, label=f"{alg}, {hold} hold")
+    ordered = [p for p in pts if p.setting.orders]
+    if ordered:
+        ax.loglog([p.cost for p in ordered], [100 * p.error for p in ordered], "o", mfc="none", mec="k", ms=11,
+                  label="with per-coupling orders")
     front = pareto(pts)
     ax.loglog([p.cost for p in front], [100 * p.error for p in front], "k:", lw=1.5, label="Pareto front")
     ax.axhline(100 * (tuning.tolerance - tuning.uncertainty), color="C3", lw=1,
