@@ -67,13 +67,18 @@ def test_batch_polar_plot_has_units_and_one_legend_off_the_panels(tmp_path, monk
                                    "environment.current_direction": [0.0, 90.0, 180.0]}}, tmp_path)
     rows = [{"environment.current_speed": s, "environment.current_direction": d, "status": "ok",
              "barge.force[1].max": s * 1e3, "barge.force[1].min": -s * 1e3} for s in (0.5, 1.0) for d in (0, 90, 180)]
+    # a single case after the matrix that does not set the direction (NaN in the table)
+    rows.append({"environment.current_speed": 1.0, "environment.current_direction": float("nan"), "status": "ok",
+                 "barge.force[1].max": 5.0, "barge.force[1].min": 0.0})
     figs = _figures(monkeypatch)
     plot(pd.DataFrame(rows), batch, tmp_path / "cases.png", {"barge.force[1]": "N"})
     (fig,) = figs
     ax = fig.axes[0]
     assert ax.get_title() == "max |barge.force[1]| [N]" and ax.get_legend() is None
     (legend,) = fig.legends
-    assert legend.get_title().get_text() == "environment.current_speed"
+    assert legend.get_title().get_text() == "environment.current_speed [m/s]"
+    # the radial values in the sector without data (0–180° used: at 270°), not over the lines
+    assert ax.get_rlabel_position() == 270.0
     assert [t.get_text() for t in legend.get_texts()] == ["0.5", "1.0"]
     # the legend sits below every panel
     fig.canvas.draw()

@@ -799,6 +799,24 @@ def _cell(value):
 DIRECTION_HINTS = ("direction", "heading")
 
 
+def _with_unit(knob):
+    """``'environment.current_speed [m/s]'``: a knob with the unit its key states."""
+    from .keys import unit
+    u = unit(knob)
+    return f"{knob} [{u}]" if u else knob
+
+
+def _emptiest(directions):
+    """The middle [deg] of the widest sector between the directions (degrees) a plot has data at."""
+    d = np.asarray(directions, float)
+    d = np.sort(np.unique(np.mod(d[np.isfinite(d)], 360.0)))   # single cases may not set the knob
+    if d.size == 0:
+        return 100.0
+    gaps = np.diff(np.r_[d, d[0] + 360.0])
+    k = int(np.argmax(gaps))
+    return float(np.mod(d[k] + gaps[k] / 2, 360.0))
+
+
 def plot(table, batch, path, units=None):
     """Largest |output| per case: a polar plot against the first direction knob (one line per
     combination of the other knobs, one legend for the figure below the panels), else against
@@ -831,15 +849,15 @@ def plot(table, batch, path, units=None):
         unit = units.get(name)
         ax.set_title(f"max |{name}|" + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=9, pad=14)
         ax.tick_params(labelsize=8)
-        if polar:
-            ax.set_rlabel_position(100)   # radial values off the 0° and 90° spokes
+        if polar:   # radial values in the middle of the widest sector without data: they cover no line
+            ax.set_rlabel_position(_emptiest(ok[axis].to_numpy(float)))
         else:
-            ax.set_xlabel(axis)
+            ax.set_xlabel(_with_unit(axis))
             ax.grid(True, alpha=0.3)
     if others:   # one legend for the figure, below the panels: it covers no label
         handles, labels = axes[0][0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
-                   title=", ".join(others), title_fontsize=8)
+                   title=", ".join(map(_with_unit, others)), title_fontsize=8)
     fig.suptitle(f"{batch.scene.stem}: largest value per case against {axis}"
                  + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10, y=0.98)
     fig.tight_layout(rect=(0, 0.1 if others else 0, 1, 0.92))

@@ -250,3 +250,17 @@ def effect_keys(kind, from_deck):
 
 def joint_keys(from_deck):
     return set(JOINT) | set(JOINT_DECK if from_deck else JOINT_INLINE)
+
+
+def unit(path: str) -> str | None:
+    """The unit a scene key's description states (``'m/s'`` for ``environment.current_speed``,
+    ``'kg'`` for ``bodies.barge.mass``), for labels; None when it states one of none or several."""
+    import re
+    parts = re.sub(r"\[\d+\]", "", path).split(".")
+    kind = SCENE.get(parts[0], ({},))[0]
+    table = kind.get("table") or kind.get("map")
+    rest = parts[1:] if "table" in kind else parts[2:]
+    if not table or len(rest) != 1 or rest[0] not in table:
+        return None
+    found = re.findall(r"\[([^\]]+)\]", table[rest[0]][-1])
+    return found[0] if len(found) == 1 else None
