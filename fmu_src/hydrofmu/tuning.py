@@ -535,9 +535,16 @@ def _search_ecco(runner, window, best, point, feasible, searched):
     if floor >= best.proxy:
         return (f"ECCO: pruned, it cannot pay (its fewest steps, all {top:g} s with one Runge–Kutta step each, "
                 f"cost {floor:.0f} step units, the best point {best.proxy:.0f}: {best.setting.label()})")
+    try:
+        import libcosimpy  # noqa: F401  (the test extra)
+    except ImportError:
+        return "ECCO: needs libcosimpy (pip install libcosimpy), not installed"
     base = replace(best.setting, step=top, algorithm="ecco", ecco=ECCO_TOLERANCES[0])
     runner.calibration = replace(best.setting, algorithm="jacobi")
-    runner.calibrate(base, runner.calibration)
+    try:
+        runner.calibrate(base, runner.calibration)
+    except RuntimeError as exc:   # libcosim could not run the FMUs built for it
+        return f"ECCO: not run, libcosim failed on the FMUs built for it ({exc})"
     tried = []
     for tol in ECCO_TOLERANCES:
         p = point(replace(base, ecco=tol))
