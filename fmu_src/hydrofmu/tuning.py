@@ -215,7 +215,7 @@ class _Runner:
     def __init__(self, path, window, outputs, log):
         self.path, self.window, self.log = Path(path), window, log
         self.outputs, self.manifest, self.instances = outputs, None, 0
-        self.builds, self.ratios, self._tmp = {}, [], None
+        self.builds, self.ratios, self._tmp, self.joints = {}, [], None, True
 
     def run(self, setting: Setting):
         """(times, values of the columns, seconds of stepping)."""
@@ -250,11 +250,13 @@ class _Runner:
         return result.time, result.values, seconds * n / max(n - 1, 1)
 
     def built(self, setting: Setting):
-        """The FMUs of an ECCO setting (one build per setting but its abs_tolerance, a run knob)."""
+        """The FMUs of an ECCO setting: one build per setting but its abs_tolerance (a run knob)
+        and, in a scene without joints, its largest step (a run knob too; a joint's default
+        spring follows it)."""
         import tempfile
         from .fmi.build import build_scene
         from .scene import load_scene
-        key = replace(setting, ecco=1.0)
+        key = replace(setting, ecco=1.0, step=setting.step if self.joints else STEPS[-1])
         if key not in self.builds:
             if self._tmp is None:
                 self._tmp = tempfile.TemporaryDirectory(prefix="hydrofmu-tune-")
@@ -269,8 +271,9 @@ class _Runner:
         from .cosim import libcosim
         clock = {}
         try:
-            r = libcosim.run(self.built(setting), stop=self.window, algorithm="ecco", record=self.columns,
-                             ecco={"abs_tolerance": setting.ecco}, timing=clock)
+            r = libcosim.run(self.built(setting), stop=self.window, step=setting.first_step(), algorithm="ecco",
+                             record=self.columns, timing=clock,
+                             ecco={"abs_tolerance": setting.ecco, "min_step": ECCO_MIN, "max_step": setting.step})
         except RuntimeError as exc:
             return None, str(exc), float("nan")
         keep = r.time <= self.window + 1e-9
@@ -342,6 +345,7 @@ def _tune(path, own, tolerance, outputs, window, repeats, png, log, cache):
     cache = {} if cache is None else cache
     key = (str(path), window, tuple(outputs or ()))
     runner = cache.setdefault(("runner",) + key, _Runner(path, window, outputs, log))
+    runner.joints = bool(own.joints)
     stop = own.run["stop"]
     fits = lambda step: (not whole_steps(window, step)[1] and not whole_steps(stop, step)[1]) and step <= window / 2
     runs = cache.setdefault(("runs",) + key, {})
