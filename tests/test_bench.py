@@ -183,3 +183,6 @@ def test_bench_lines_never_contradict_their_numbers():
          "startup_x": 2.88, "step_spread": 0.8, "step_noisy": True, "startup_spread": 0.1, "startup_noisy": False}
     line = flavour_line(r, 0.05)
     assert "322" not in line and "too noisy (spread 80 % > 25 %), no figure" in line and "118 ms" in line
+    from hydrofmu.bench.compiled import libcosim_line
+    line = libcosim_line("ring", _row("ring", [[60e-6, 14e-6, 0.01, 0.1], [60e-6, -4e-6, 0.01, 0.1]]), 0.05)
+    assert "below the noise" in line and not re.search(r"-\d", line) and "14 µs" not in line, line
