@@ -177,13 +177,9 @@ def libcosim_line(label, r, step):
     """A scene in libcosim against our master on the same FMUs (a row of
     ``native.compare_scene``): a noisy figure is said to be so, not printed."""
     from .timing import over
-    if r.get("step_lost"):
-        per_step = "per step too noisy (a round measured no cost per step: below the noise of its runs), no figure"
-    elif r["step_noisy"]:
-        per_step = f"per step too noisy ({over(r['step_spread'], NOISY)}), no figure"
-    else:
-        per_step = (f"{r['step_us']:.0f} µs per step ({r['step_x']:.2f}× our master on the same FMUs, "
-                    f"{r['step_fmpy_us']:.0f} µs), real-time factor {step / (1e-6 * r['step_us']):.0f}")
+    per_step = native.step_figure(r, f"{r['step_us']:.0f} µs per step ({r['step_x']:.2f}× our master on the same "
+                                     f"FMUs, {r['step_fmpy_us']:.0f} µs), real-time factor "
+                                     f"{step / (1e-6 * r['step_us']):.0f}")
     start = (f"startup too noisy ({over(r['startup_spread'], NOISY)}), no figure" if r["startup_noisy"] else
              f"startup of a later run {1e3 * r['startup_s']:.0f} ms ({r['startup_x']:.2f}× ours)")
     return f"{label} in libcosim: {per_step}; {start}"

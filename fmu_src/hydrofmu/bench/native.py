@@ -145,6 +145,17 @@ def _row(label, t):
             "startup_noisy": spread(start_x) > NOISY}
 
 
+def step_figure(r, text):
+    """``text``, the per-step figure of a row of ``compare``/``compare_scene``, unless it is
+    noise: then what to say instead (no ratio or spread of a difference lost in noise)."""
+    from .timing import over
+    if r.get("step_lost"):
+        return "per step too noisy (a round measured no cost per step: below the noise of its runs), no figure"
+    if r["step_noisy"]:
+        return f"per step too noisy ({over(r['step_spread'], NOISY)}), no figure"
+    return text
+
+
 def compare_scene(folder, rounds=5, steps=2000, record=None):
     """A built scene (its folder) run with Jacobi exchanges by libcosim (libcosimpy: the FMUs
     are called from libcosim's C++ worker threads, which Python does not know) and by our fmpy

@@ -368,13 +368,8 @@ def part_native(out, quick):
 
 def native_line(r, scene=False):
     """One line of the native part: a row of ``native.compare`` (or ``compare_scene``: ``scene``)."""
-    if r.get("step_lost"):
-        step = "too noisy per step (a round measured no cost per step: below the noise of its runs), no figure"
-    elif r["step_noisy"]:
-        step = f"too noisy per step ({over(r['step_spread'], floor.NOISY)}), no figure"
-    else:
-        step = (f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
-                f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
+    step = native.step_figure(r, f"{r['step_x']:.2f}× fmpy per step ({r['step_us']:.1f} vs {r['step_fmpy_us']:.1f} µs, "
+                                 f"{'met' if r['step_x'] <= 1.0 else 'NOT met'})")
     start = (f"startup {1e3 * r['startup_s']:.0f} ms native (Python started by the FMU) vs "
              f"{1e3 * r['startup_fmpy_s']:.0f} ms under fmpy (Python running)" if not scene else
              f"startup of a later run {1e3 * r['startup_s']:.0f} ms vs {1e3 * r['startup_fmpy_s']:.0f} ms "
