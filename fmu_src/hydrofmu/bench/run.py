@@ -501,7 +501,14 @@ def part_waves(out, quick):
     if rows is None:
         return [f"skipped: needs {waves_cost.DATA} (a repository checkout)"]
     write_csv(out / "waves.csv", rows)
-    return waves_lines(rows)
+    lines = waves_lines(rows)
+    from . import waves_motions
+    motions = waves_motions.measure(out / "waves_motions", quick)
+    if motions:
+        write_csv(out / "waves_motions.csv", motions)
+        lines += ["motions in regular waves, radiation damping only, against X(ω) of the dataset (% of each dof's "
+                  "peak |X|): " + line for line in waves_motions.summary(motions)]
+    return lines
 
 
 def waves_lines(rows):
@@ -524,12 +531,6 @@ def waves_lines(rows):
                    f"at {rows[0]['components']}: {ratio:.2f})")
     lines.append("the effect in the load FMU (in-process, with − without waves): " + effect + "; the kernel alone "
                  + ", ".join(f"{r['kernel_per_100_us']:.1f}" for r in rows) + " µs per 100 components")
-    from . import waves_motions
-    motions = waves_motions.measure(out / "waves_motions", quick)
-    if motions:
-        write_csv(out / "waves_motions.csv", motions)
-        lines += ["motions in regular waves, radiation damping only, against X(ω) of the dataset (% of each dof's "
-                  "peak |X|): " + line for line in waves_motions.summary(motions)]
     return lines
 
 
