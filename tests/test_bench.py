@@ -183,6 +183,12 @@ def test_bench_lines_never_contradict_their_numbers():
          "startup_x": 2.88, "step_spread": 0.8, "step_noisy": True, "startup_spread": 0.1, "startup_noisy": False}
     line = flavour_line(r, 0.05)
     assert "322" not in line and "too noisy (spread 80 % > 25 %), no figure" in line and "118 ms" in line
+    from hydrofmu.bench.run import growth_line
+    rows = [{"lags": 100, "convolution_us": 10.0, "state_space_us": 5.0, "convolution_spread": 0.1, "state_space_spread": 0.4},
+            {"lags": 400, "convolution_us": 14.0, "state_space_us": 4.3, "convolution_spread": 0.05, "state_space_spread": 0.1}]
+    line = growth_line(rows)
+    assert "convolution ×1.4" in line and "state-space too noisy (spread 40 % > 25 % between rounds), no figure" in line
+    assert "0.86" not in line
     from hydrofmu.bench.compiled import libcosim_line
     line = libcosim_line("ring", _row("ring", [[60e-6, 14e-6, 0.01, 0.1], [60e-6, -4e-6, 0.01, 0.1]]), 0.05)
     assert "below the noise" in line and not re.search(r"-\d", line) and "14 µs" not in line, line

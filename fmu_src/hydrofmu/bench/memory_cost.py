@@ -10,7 +10,7 @@ import numpy as np
 
 from ..physics.memory import Convolution, StateSpace
 from .kernels import coupling_kernels, irregular_velocity
-from .timing import per_call
+from .timing import per_call, per_round
 
 
 def _forces(ev, dt, v):
@@ -24,15 +24,17 @@ def error(got, ref):
     return float(np.max(np.sqrt(np.mean((got - ref) ** 2, axis=0))[live] / scale[live]))
 
 
-def _timed(evaluators, dt, v, calls, rounds):
-    """Per-step cost of each evaluator, warmed past its memory, measured interleaved."""
+def _timed(evaluators, dt, v, calls, rounds, every_round=False):
+    """Per-step cost of each evaluator, warmed past its memory, measured interleaved (the
+    median; ``every_round``: each round's)."""
     for ev in evaluators.values():
         for vk in v[:calls]:
             ev.advance(dt, vk)
 
     def make(ev):
         return lambda k: ev.advance(dt, v[k])
-    return per_call({name: (lambda ev=ev: make(ev)) for name, ev in evaluators.items()}, calls, rounds)
+    makers = {name: (lambda ev=ev: make(ev)) for name, ev in evaluators.items()}
+    return per_round(makers, calls, rounds) if every_round else per_call(makers, calls, rounds)
 
 
 def tradeoff(lags=2000, timdel=0.05, duration=300.0, lengths=(5.0, 10.0, 20.0, 40.0),
@@ -81,8 +83,10 @@ def growth(lag_counts=(100, 300, 1000, 3000, 10000), timdel=0.05, tol=0.01, call
         for ev in cands.values():             # fill the whole memory before timing
             for vk in v[:lags]:
                 ev.advance(timdel, vk)
-        cost = _timed(cands, timdel, v[lags:], calls, rounds)
+        times = _timed(cands, timdel, v[lags:], calls, rounds, every_round=True)
+        cost = {name: float(np.median(t)) for name, t in times.items()}
         rows.append({"lags": lags, "memory_s": (lags - 1) * timdel,
                      "convolution_us": 1e6 * cost["convolution"], "state_space_us": 1e6 * cost["state_space"],
-                     "states": cands["state_space"].order})
+                     "states": cands["state_space"].order,
+                     **{f"{name}_spread": float(np.ptp(t) / np.median(t)) for name, t in times.items()}})
     return rows

@@ -282,9 +282,22 @@ def part_growth(out, quick):
     fig.savefig(out / "growth.png", dpi=120)
     plt.close(fig)
     late = [r["us_per_step"] for r in flat if r["t_start"] >= 60.0]
-    return [f"kernel {lags[0]['lags']} → {lags[-1]['lags']} lags: convolution ×{lags[-1]['convolution_us'] / lags[0]['convolution_us']:.1f}, "
-            f"state-space ×{lags[-1]['state_space_us'] / lags[0]['state_space_us']:.2f}",
+    return [growth_line(lags),
             f"cost per step after the memory fills: last/first = {late[-1] / late[0]:.2f}" if len(late) > 1 else ""]
+
+
+def growth_line(lags):
+    """Cost growth of each evaluator from the shortest kernel to the longest (rows of
+    ``memory_cost.growth``); one whose rounds spread more than ``floor.NOISY`` at either end
+    is said to be too noisy instead."""
+    first, last = lags[0], lags[-1]
+    parts = []
+    for name, label, digits in (("convolution", "convolution", 1), ("state_space", "state-space", 2)):
+        spread = max(first.get(f"{name}_spread", 0.0), last.get(f"{name}_spread", 0.0))
+        parts.append(f"{label} too noisy ({over(spread, floor.NOISY)} between rounds), no figure"
+                     if spread > floor.NOISY else
+                     f"{label} ×{last[f'{name}_us'] / first[f'{name}_us']:.{digits}f}")
+    return f"kernel {first['lags']} → {last['lags']} lags: " + "; ".join(parts)
 
 
 def part_floor(out, quick):
