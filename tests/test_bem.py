@@ -321,6 +321,10 @@ COARSE = {   # sub-grids of the dataset's 0.05…5 rad/s (Δω = 0.05) up to 3.5
     "45 nearest to an even spacing of 0.078 rad/s": lambda w: np.unique(
         [np.argmin(np.abs(w - x)) for x in np.linspace(3.5 / 45, 3.5, 45)]),
     "every other one, Δω = 0.1 rad/s (35)": lambda w: np.nonzero((np.arange(w.size) % 2 == 1) & (w <= 3.5 + 1e-9))[0],
+    # docs/bem.md's Δω = 0.15 row: the cut that ends at 3.5 (the two that end at 3.4 and 3.45
+    # miss 1 %: the tail then starts below the data's last point)
+    "every third one from 0.05, Δω = 0.15 rad/s (24)": lambda w: np.nonzero(
+        (np.arange(w.size) % 3 == 0) & (w <= 3.5 + 1e-9))[0],
 }
 
 
@@ -334,7 +338,7 @@ def test_coarse_grid_rebuilds_the_full_resolution_values(grid):
     d, w, a, b, (scale_a, scale_b) = full_resolution(3.5)
     sel = COARSE[grid](d.omega)
     r = transform(d.omega[sel], d.added_mass[sel], d.damping[sel], d.a_inf)
-    assert 35 <= sel.size <= 45 and r.a_inf_source == "Ogilvie" and np.isclose(r.omega[-1], 3.5)
+    assert 24 <= sel.size <= 45 and r.a_inf_source == "Ogilvie" and np.isclose(r.omega[-1], 3.5)
     between = ~np.isin(w, d.omega[sel]) & (w > d.omega[sel][0])
     assert between.sum() >= 20
     fit_a, fit_b = r.rebuilt(w)
