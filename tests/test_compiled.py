@@ -295,14 +295,20 @@ def assert_no_python_loaded(run):
     assert not [line for line in run.stderr.splitlines() if "python" in line.lower()], run.stderr[-2000:]
 
 
-@pytest.mark.parametrize("name", ["side_by_side", "joined_barges"])
-def test_compiled_fmus_run_in_a_c_host_without_python(name, compiled, hosts, tmp_path):
+def built(name, compiled, wave_builds):
+    """A compiled scene folder: one of models/ or, as "waves: <name>", of WAVE_SCENES."""
+    return wave_builds[name.split(": ", 1)[1]] if name.startswith("waves: ") else compiled[name]
+
+
+@pytest.mark.parametrize("name", ["side_by_side", "joined_barges", "waves: irregular"])
+def test_compiled_fmus_run_in_a_c_host_without_python(name, compiled, wave_builds, hosts, tmp_path):
     """Every FMU of the scene in the generic C host with no Python to be found: ``ldd`` of
     the binary names no libpython, the loader loads none, and the outputs equal fmpy's run
-    of the same FMU in this process (same inputs)."""
+    of the same FMU in this process (same inputs).  The wave scene: JONSWAP with spreading on
+    two bodies, BEM hydrostatics."""
     from test_native import fmpy_reference, run_fmi_host, unzip
     env = no_python_env(tmp_path)
-    for fmu in sorted(compiled[name].glob("*.fmu")):
+    for fmu in sorted(built(name, compiled, wave_builds).glob("*.fmu")):
         unzipped = unzip(fmu, tmp_path / fmu.stem)
         folder, mid, _, refs = unzipped
         binary = folder / "binaries" / "linux64" / f"{mid}.so"
@@ -322,13 +328,15 @@ def test_compiled_fmus_run_in_a_c_host_without_python(name, compiled, hosts, tmp
             assert v == pytest.approx(ref[n, vr], rel=1e-12, abs=1e-9), (fmu.name, n, vr)
 
 
-def test_compiled_scene_runs_in_libcosim_c_api_without_python(compiled, hosts, tmp_path):
-    """joined_barges compiled (load, joint and dynamics FMUs) in libcosim's C API from a
-    process with no Python to be found equals our fmpy Jacobi master on the same FMUs."""
+@pytest.mark.parametrize("name", ["joined_barges", "waves: irregular"])
+def test_compiled_scene_runs_in_libcosim_c_api_without_python(name, compiled, wave_builds, hosts, tmp_path):
+    """joined_barges compiled (load, joint and dynamics FMUs), and the irregular-sea pair
+    (wave excitation, hydrostatics), in libcosim's C API from a process with no Python to be
+    found equals our fmpy Jacobi master on the same FMUs."""
     import json
     from hydrofmu.cosim import master
     from test_native import assert_equals_jacobi, run_cosim
-    folder = compiled["joined_barges"]
+    folder = built(name, compiled, wave_builds)
     step = json.loads((folder / "manifest.json").read_text())["run"]["step"]
     env = no_python_env(tmp_path)
     tables = run_cosim(hosts, folder / "OspSystemStructure.xml", 30 * step, step, tmp_path / "out", env=env)
