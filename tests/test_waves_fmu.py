@@ -37,26 +37,9 @@ def dataset(path):
 
 
 def body_table(name, m, x, damping, bem):
-    """A freely floating cylinder of the datasets (make_waves_data.py): mass = displaced
-    mass, centre of mass 3 m below the waterline, radii of gyration 2, 2, 1.5 m."""
-    return f"""
-[bodies.{name}]
-position = [{x}, 0.0, 0.0]
-mass = {m!r}
-inertia = [{4 * m!r}, {4 * m!r}, {2.25 * m!r}]
-cog = [0.0, 0.0, -3.0]
-damping = {list(damping)}
-
-[[bodies.{name}.effects]]
-type = "wave_excitation"
-bem = "{bem}"
-body = "{name}"
-
-[[bodies.{name}.effects]]
-type = "bem_hydrostatics"
-bem = "{bem}"
-body = "{name}"
-"""
+    """A freely floating cylinder of the datasets (the bench's table, with added damping)."""
+    from hydrofmu.bench.waves_motions import body_table as table
+    return table(name, m, x, bem, damping)
 
 
 def write_scene(folder, text, name="waves"):

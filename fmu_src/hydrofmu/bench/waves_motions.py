@@ -29,13 +29,19 @@ CASES = {   # dataset, {body: x}, frequencies [rad/s], steps [s], stop [s]
 QUICK = {"cylinder": ((1.35, 1.5), (0.05, 0.025)), "pair": ((1.45, 1.55), (0.05,))}
 
 
-def _body(name, x, m, bem):
+def body_table(name, m, x, bem, damping=None):
+    """A freely floating cylinder of the wave datasets (tests/data/bem/make_waves_data.py):
+    mass = displaced mass ``m`` [kg], centre of mass 3 m below the waterline, radii of gyration
+    2, 2, 1.5 m, at x [m]; wave excitation and hydrostatics from ``bem``; ``damping``: an
+    optional diagonal of added linear damping (six values, SI)."""
+    extra = f"damping = {list(damping)}\n" if damping is not None else ""
     return f"""
 [bodies.{name}]
 position = [{x}, 0.0, 0.0]
 mass = {m!r}
 inertia = [{4 * m!r}, {4 * m!r}, {2.25 * m!r}]
 cog = [0.0, 0.0, -3.0]
+{extra}
 [[bodies.{name}.effects]]
 type = "wave_excitation"
 bem = "{bem}"
@@ -53,7 +59,7 @@ def scene_text(bem, bodies, m, step, stop):
     mapping = ", ".join(f'{n} = "{n}"' for n in bodies)
     return (f'[run]\nstep = {step}\nstop = {stop}\nsubstep = {step}\nload_hold = "linear"\n\n'
             '[waves]\nspectrum = "regular"\nheight = 0.002\nperiod = 5.0\ndirection = 0.0\nramp = 30.0\n'
-            + "".join(_body(n, x, m, bem) for n, x in bodies.items())
+            + "".join(body_table(n, m, x, bem) for n, x in bodies.items())
             + f'\n[[couplings]]\nbem = "{bem}"\nbodies = {{ {mapping} }}\nmethod = "convolution"\n'
               'memory_length = 40.0\ndofs = ["Surge", "Heave", "Pitch"]\n')
 
