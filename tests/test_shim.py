@@ -663,6 +663,7 @@ def test_slave_that_cannot_start_is_refused_not_a_corrupted_host(demo_build, tmp
                          env=env, timeout=120)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "cannot start: JSONDecodeError" in run.stdout + run.stderr
+    assert "get_real" not in run.stdout + run.stderr   # the reason is the one line about it
     assert "refused:" in run.stdout
     # none released twice (before the fix: 9 -> 8; pythonfmu's fresh fmi2Instantiate of the
     # recovery keeps one reference for good, in the MRO list it leaks: 9 -> 10 now)
