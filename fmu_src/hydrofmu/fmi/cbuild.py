@@ -72,10 +72,6 @@ def _env(slave):
     return env
 
 
-def _inputs(slave):
-    return ("inputs", np.r_[tuple(slave.inputs)].tolist() if slave.inputs else [])
-
-
 # the sea-state knobs in the order of the 'waves' record (models.c reads them in this order)
 SEA_KNOBS = ("height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp")
 SPECTRA = {"regular": 0, "jonswap": 1, "pierson_moskowitz": 2}
@@ -100,7 +96,7 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     if isinstance(desc, description.LoadFMU):
         if getattr(desc, "waves", None) is not None:
             recs += _waves(slave)
-        recs += [("motion", _motion(slave.motion_inputs)), *_env(slave), _inputs(slave),
+        recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]
         for e, out in zip(slave.loads.effects, slave.effect_force):
             if not hasattr(e, "C_TAG"):
@@ -117,7 +113,7 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
                 recs.append((ev.C_TAG, ev.c_params()))
     elif isinstance(desc, description.ConnectorFMU):
         recs += [("sides", _motion(slave.side_a) + (_motion(slave.side_b) if slave.side_b else [-1] * 4)),
-                 *_env(slave), _inputs(slave), ("explicit", [slave.explicit]),
+                 *_env(slave), ("explicit", [slave.explicit]),
                  ("joint", slave.joint.c_params()), ("node", slave.joint.node.c_params()),
                  ("outputs", [slave.force_a.start, slave.force_b.start, slave.gap.start, slave.rotation.start])]
     else:

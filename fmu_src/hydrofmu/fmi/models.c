@@ -179,7 +179,6 @@ typedef struct {
     const double *waves, *transfer;        /* the 'waves' and 'transfer' records (NULL: no waves) */
     double *wave;                          /* waves.c's per-step parameters (NULL: not drawn yet) */
     int wave_force, wave_elevation;
-    int *inputs, ninputs;
     Effect *effects;
     int neffects;
     Coupling *couplings;
@@ -191,15 +190,8 @@ static void load_release(Instance *inst) {
     if (!L) return;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) memory_free(&L->couplings[k].memory);
-    free(L->inputs), free(L->effects), free(L->couplings), free(L->wave), free(L);
+    free(L->effects), free(L->couplings), free(L->wave), free(L);
     inst->data = NULL;
-}
-
-static int inputs_setup(Instance *inst, int **inputs, int *n) {
-    const Record *r = hf_record(inst, "inputs", NULL);
-    if (!r) return -1;
-    *inputs = int_list(r->v, r->n), *n = r->n;
-    return *inputs ? 0 : -1;
 }
 
 static int load_setup(Instance *inst) {
@@ -207,7 +199,7 @@ static int load_setup(Instance *inst) {
     inst->data = L;
     const Record *r = hf_record(inst, "motion", NULL), *t = hf_record(inst, "total", NULL),
                  *x = hf_record(inst, "explicit", NULL);
-    if (!L || !r || r->n != 4 || !t || t->n != 1 || !x || env_setup(inst, &L->env) || inputs_setup(inst, &L->inputs, &L->ninputs))
+    if (!L || !r || r->n != 4 || !t || t->n != 1 || !x || env_setup(inst, &L->env))
         goto bad;
     for (int k = 0; k < 4; k++) L->motion.refs[k] = ivr(r->v[k]);
     L->total = ivr(t->v[0]), L->explicit_ = x->v[0] != 0.0;
@@ -392,13 +384,12 @@ typedef struct {
     Side a, b;
     int has_b, force_a, force_b, gap, rotation, explicit_;
     EnvRefs env;
-    int *inputs, ninputs;
     const double *joint, *node;
 } Connector;
 
 static void connector_release(Instance *inst) {
     Connector *C = inst->data;
-    if (C) free(C->inputs), free(C);
+    free(C);
     inst->data = NULL;
 }
 
@@ -409,7 +400,7 @@ static int connector_setup(Instance *inst) {
                  *n = hf_record(inst, "node", NULL), *o = hf_record(inst, "outputs", NULL),
                  *x = hf_record(inst, "explicit", NULL);
     if (!C || !s || s->n != 8 || !j || j->n != 22 || !n || n->n != 12 || !o || o->n != 4 || !x ||
-        env_setup(inst, &C->env) || inputs_setup(inst, &C->inputs, &C->ninputs)) {
+        env_setup(inst, &C->env)) {
         hf_fail(inst, "model.bin: the connector model's records are incomplete or of the wrong size");
         return -1;
     }
