@@ -455,6 +455,78 @@ def test_guards_return_error_never_crash(compiled, tmp_path):
     assert "does not match this FMU's" in lines[-1][1]
 
 
+def guarded_slave(fmu, tmp):
+    """(slave, {name: value reference}, log lines [(status, message)]) of a compiled FMU
+    instantiated by fmpy with a logger that keeps its lines."""
+    from fmpy import calloc, free, read_model_description
+    from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+    from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE
+    unzipped = Path(tmp) / "u"
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(unzipped)
+    md = read_model_description(str(fmu))
+    lines = []
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: lines.append((status, msg.decode())))
+    cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    s = FMU2Slave(guid=md.guid, unzipDirectory=str(unzipped), modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="g")
+    s.instantiate(callbacks=cb)
+    s._keep = cb   # (the callbacks must outlive the instance)
+    return s, {v.name: v.valueReference for v in md.modelVariables}, lines
+
+
+def test_fast_paths_keep_every_guard(compiled, tmp_path):
+    """What fmu.c skips on the hot path is skipped only when it is known: the references a
+    master set last (not once initialization has fixed a parameter among them), the inputs'
+    finiteness (a NaN set again, or left in place while another input is set, still fails
+    every step), the outputs read after a checked step (a parameter made NaN before
+    initialization is still refused when read)."""
+    from fmpy.fmi1 import FMICallException
+    s, refs, lines = guarded_slave(compiled["side_by_side"] / "side_by_side_barge_a.fmu", tmp_path)
+    both, force = [refs["rho"], refs["velocity[2]"]], [refs["force[2]"]]
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.setReal(both, [1025.0, 0.1])   # a parameter may be set before initialization ...
+    s.exitInitializationMode()
+    with pytest.raises(FMICallException):   # ... the same references after it may not
+        s.setReal(both, [1025.0, 0.2])
+    assert "cannot set rho: a parameter, fixed after initialization" in lines[-1][1]
+    s.setReal([refs["velocity[2]"]], [0.2])
+    s.doStep(0.0, 0.1)
+    t = 0.1
+    for k in range(2):   # the same NaN twice: two failed steps
+        s.setReal([refs["velocity[2]"]], [float("nan")])
+        with pytest.raises(FMICallException):
+            s.doStep(t, 0.1)
+        assert "input velocity[2] = nan is not finite" in lines[-1][1], (k, lines[-1])
+    s.setReal([refs["velocity[1]"]], [0.1])   # another input set: the NaN is still there
+    with pytest.raises(FMICallException):
+        s.doStep(t, 0.1)
+    assert "input velocity[2] = nan is not finite" in lines[-1][1]
+    s.setReal([refs["velocity[2]"]], [0.2])
+    s.doStep(t, 0.1)
+    assert np.isfinite(s.getReal(force)).all()
+    s.terminate()
+    s.freeInstance()
+
+    s, refs, lines = guarded_slave(compiled["side_by_side"] / "side_by_side_barge_a.fmu", tmp_path / "nan")
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.setReal([refs["g"]], [float("nan")])
+    s.exitInitializationMode()
+    try:
+        s.doStep(0.0, 0.1)
+    except FMICallException:
+        pass
+    with pytest.raises(FMICallException):
+        s.getReal([refs["g"]])
+    assert "g = nan is not finite" in lines[-1][1], lines[-1]
+    s.terminate()
+    s.freeInstance()
+
+
 # -- sources and other platforms ---------------------------------------------------------------
 
 def test_fmu_sources_alone_compile_into_the_same_fmu(compiled, tmp_path):

@@ -11,6 +11,12 @@
  * copies them.  Outputs are evaluated again only when an input changes (fmi2SetReal of the
  * value an input already holds changes nothing), and then only what depends on it.
  *
+ * What the hot path skips it knows: the value references of the last fmi2SetReal were all
+ * settable (unless initialization has ended since), the inputs are finite unless a value set
+ * was not (each set value's bits are looked at as it is stored; a NaN left in place keeps its
+ * input suspect), and after a step that checked its inputs and outputs (parameters checked
+ * when initialization fixed them) fmi2GetReal copies without checking again.
+ *
  * Resources: variables.txt ("hydrofmu-c 1 <guid>", then "<causality> <name>" per value
  * reference) and model.bin (records: 32-byte tag, int64 count, that many float64, little
  * endian), both written by hydrofmu.fmi.cbuild.
@@ -80,10 +86,24 @@ const Record *hf_record(const Instance *inst, const char *tag, int *from) {
     return NULL;
 }
 
+/* The top bit set when x is inf or NaN: its exponent bits are all ones, and adding one there
+ * carries into the top bit.  OR-ed over many values, integer operations only: no chain of
+ * floating-point additions to wait for, no false alarm from a sum of large values. */
+static inline uint64_t not_finite_bit(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return (b & 0x7ff0000000000000u) + 0x0010000000000000u;
+}
+
+/* 1 when none of the values at vrs is inf or NaN */
+static int all_finite(const double *values, const int *vrs, int n) {
+    uint64_t bits = 0;
+    for (int k = 0; k < n; k++) bits |= not_finite_bit(values[vrs[k]]);
+    return !(bits >> 63);
+}
+
 int hf_check_finite(Instance *inst, const int *vrs, int n) {
-    double sum = 0.0;
-    for (int k = 0; k < n; k++) sum += inst->values[vrs[k]];
-    if (isfinite(sum)) return 1;
+    if (all_finite(inst->values, vrs, n)) return 1;
     for (int k = 0; k < n; k++)
         if (!isfinite(inst->values[vrs[k]])) {
             hf_set_error(inst, "input %s = %g is not finite", inst->names[vrs[k]], inst->values[vrs[k]]);
@@ -183,6 +203,13 @@ static int read_variables(Instance *inst, const char *folder, const char *guid) 
         if (inst->causality[k] == 'o') inst->outputs[inst->noutputs++] = k;
         if (inst->causality[k] == 'i') inst->inputs[inst->ninputs++] = k;
     }
+    inst->spans = calloc(2 * (size_t)n + 2, sizeof(int));
+    if (!inst->spans) return -1;
+    for (int k = 0; k < inst->noutputs; k++) {
+        int *last = inst->spans + 2 * (inst->nspans - 1);
+        if (inst->nspans && last[0] + last[1] == inst->outputs[k]) last[1]++;
+        else inst->spans[2 * inst->nspans] = inst->outputs[k], inst->spans[2 * inst->nspans + 1] = 1, inst->nspans++;
+    }
     return 0;
 }
 
@@ -244,6 +271,7 @@ static void free_instance(Instance *inst) {
     for (int k = 0; k < inst->nvars && inst->names; k++) free(inst->names[k]);
     for (int k = 0; k < inst->nrec; k++) free(inst->rec[k].v);
     free(inst->names), free(inst->causality), free(inst->outputs), free(inst->inputs), free(inst->rec);
+    free(inst->spans), free(inst->checked_vr);
     free(inst->values), free(inst->start), free(inst->name);
     free(inst);
 }
@@ -254,6 +282,7 @@ static int restart(Instance *inst) {
     inst->data = NULL;
     memcpy(inst->values, inst->start, sizeof(double) * inst->nvars);
     inst->running = 0, inst->stale = 1, inst->suspect = 1, inst->changed = 1, inst->has_next = 0, inst->error[0] = 0;
+    inst->clean = 0;
     return inst->model->setup(inst);
 }
 
@@ -333,8 +362,16 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     return fmi2OK;
 }
 
+/* 1: every value that is neither an input nor an output is finite (they are fixed from here on) */
+static int fixed_finite(const Instance *inst) {
+    for (int k = 0; k < inst->nvars; k++)
+        if (inst->causality[k] != 'i' && inst->causality[k] != 'o' && !isfinite(inst->values[k])) return 0;
+    return 1;
+}
+
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ENTER(c);
+    inst->fixed_finite = fixed_finite(inst), inst->clean = 0;
     inst->model->start(inst);
     inst->running = 1, inst->stale = 1;
     return (fmi2Status)inst->status;
@@ -372,7 +409,7 @@ static int inputs_finite(Instance *inst) {
 
 static void evaluate(Instance *inst) {
     if (!inputs_finite(inst)) return;   /* (stale stays: the next read fails too) */
-    inst->stale = 0;
+    inst->stale = 0, inst->clean = 0;
     inst->model->evaluate(inst);
 }
 
@@ -385,9 +422,13 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
         hf_fail(inst, "%s", inst->error);
         return fmi2Error;
     }
-    double sum = 0.0;
-    for (size_t k = 0; k < n; k++) sum += value[k] = inst->values[vr[k]];
-    if (!isfinite(sum))
+    if (inst->clean) {   /* (checked at the end of the step) */
+        for (size_t k = 0; k < n; k++) value[k] = inst->values[vr[k]];
+        return fmi2OK;
+    }
+    uint64_t bits = 0;
+    for (size_t k = 0; k < n; k++) bits |= not_finite_bit(value[k] = inst->values[vr[k]]);
+    if (bits >> 63)
         for (size_t k = 0; k < n; k++)
             if (!isfinite(value[k])) {
                 hf_fail(inst, "%s %s = %g is not finite", inst->causality[vr[k]] == 'o' ? "output" : "variable",
@@ -397,32 +438,58 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
     return (fmi2Status)inst->status;
 }
 
+/* 1: every reference can be set now, else logged (the first that cannot) */
+static int settable(Instance *inst, const fmi2ValueReference vr[], size_t n) {
+    for (size_t k = 0; k < n; k++) {
+        char cs = vr[k] < (fmi2ValueReference)inst->nvars ? inst->causality[vr[k]] : 0;
+        if (cs == 'i' || (cs == 'p' && !inst->running)) continue;
+        if (!cs) {
+            hf_fail(inst, "fmi2SetReal: value reference %u out of range 0...%d", vr[k], inst->nvars - 1);
+            return 0;
+        }
+        const char *why = cs == 'p' ? "a parameter, fixed after initialization"
+                        : cs == 'o' ? "not settable (output)"
+                        : cs == 'c' ? "not settable (calculatedParameter)" : "not settable (local)";
+        hf_fail(inst, "cannot set %s: %s", inst->names[vr[k]], why);
+        return 0;
+    }
+    return 1;
+}
+
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[]) {
     ENTER(c);
     if (n && (!vr || !value)) {
         hf_fail(inst, "fmi2SetReal: NULL value references or values for %zu variables", n);
         return fmi2Error;
     }
-    for (size_t k = 0; k < n; k++) {   /* every reference checked before any value is set */
-        char cs = vr[k] < (fmi2ValueReference)inst->nvars ? inst->causality[vr[k]] : 0;
-        if (cs == 'i' || (cs == 'p' && !inst->running)) continue;
-        if (!cs) {
-            hf_fail(inst, "fmi2SetReal: value reference %u out of range 0...%d", vr[k], inst->nvars - 1);
-            return fmi2Error;
+    /* every reference checked before any value is set; a master sets the same references at
+     * every step, and those it set last are known good (while running does not change) */
+    int known = n && n == inst->nchecked && inst->running == inst->checked_running &&
+                memcmp(vr, inst->checked_vr, n * sizeof *vr) == 0;
+    if (!known) {
+        if (!settable(inst, vr, n)) return fmi2Error;
+        if (n > inst->checked_cap) {
+            unsigned *more = realloc(inst->checked_vr, n * sizeof *more);
+            if (more) inst->checked_vr = more, inst->checked_cap = n;
         }
-        const char *why = cs == 'p' ? "a parameter, fixed after initialization"
-                        : cs == 'o' ? "not settable (output)"
-                        : cs == 'c' ? "not settable (calculatedParameter)" : "not settable (local)";
-        hf_fail(inst, "cannot set %s: %s", inst->names[vr[k]], why);
-        return fmi2Error;
+        if (n <= inst->checked_cap) {
+            memcpy(inst->checked_vr, vr, n * sizeof *vr);
+            inst->nchecked = n, inst->checked_running = inst->running;
+        }
     }
-    int changed = 0;
-    for (size_t k = 0; k < n; k++) {   /* (a NaN never equals what is there: it counts as changed) */
-        changed |= inst->values[vr[k]] != value[k];
+    /* changed: any bit differs (the same NaN set again is no change: its input stays suspect
+     * until a check passes); bad: a value set is not finite (integer operations: no chains) */
+    uint64_t changed = 0, bad = 0, old, new;
+    for (size_t k = 0; k < n; k++) {
+        memcpy(&old, inst->values + vr[k], sizeof old);
+        memcpy(&new, value + k, sizeof new);
+        changed |= old ^ new;
+        bad |= not_finite_bit(value[k]);
         inst->values[vr[k]] = value[k];
     }
     if (changed) {
-        inst->stale = 1, inst->suspect = 1, inst->changed = 1;
+        inst->stale = 1, inst->changed = 1, inst->clean = 0;
+        if (bad >> 63) inst->suspect = 1;   /* (else the inputs are as finite as they were) */
         inst->error[0] = 0;   /* new inputs: the next evaluation checks them afresh */
     }
     return fmi2OK;
@@ -461,9 +528,12 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 }
 
 static int outputs_finite(Instance *inst) {
-    double sum = 0.0;
-    for (int k = 0; k < inst->noutputs; k++) sum += inst->values[inst->outputs[k]];
-    if (isfinite(sum)) return 1;
+    uint64_t bits = 0;   /* (run by run: no index to load per value) */
+    for (int r = 0; r < inst->nspans; r++) {
+        const double *x = inst->values + inst->spans[2 * r];
+        for (int k = 0; k < inst->spans[2 * r + 1]; k++) bits |= not_finite_bit(x[k]);
+    }
+    if (!(bits >> 63)) return 1;
     for (int k = 0; k < inst->noutputs; k++) {
         int vr = inst->outputs[k];
         if (!isfinite(inst->values[vr])) {
@@ -490,6 +560,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
             inst->next_time = t + h, inst->has_next = 1;   /* (the outputs' time: waves) */
             if (inst->stale) evaluate(inst);
             if (!inst->error[0] && !outputs_finite(inst)) return fmi2Error;
+            /* inputs and outputs checked, the rest fixed and checked: reads need no check */
+            inst->clean = !inst->error[0] && !inst->suspect && !inst->stale && inst->fixed_finite;
         }
     }
     if (inst->error[0]) {
@@ -555,6 +627,7 @@ static fmi2Status set_state(Instance *inst, const double *d, size_t n) {
     }
     inst->running = d[0] != 0.0, inst->has_next = d[1] != 0.0, inst->next_time = d[2];
     inst->stale = 1, inst->suspect = 1, inst->changed = 1, inst->error[0] = 0;
+    inst->fixed_finite = fixed_finite(inst), inst->clean = 0;
     return fmi2OK;
 }
 

@@ -42,6 +42,10 @@ struct Instance {
     char *causality;        /* 'p' parameter, 'c' calculated parameter, 'i' input, 'o' output, 'l' local */
     int *outputs, noutputs;
     int *inputs, ninputs;   /* value references of the outputs and of the inputs */
+    int *spans, nspans;     /* the outputs as runs of consecutive value references: (first, count) pairs */
+    unsigned *checked_vr;   /* the value references of the last fmi2SetReal that were all settable */
+    size_t nchecked, checked_cap;
+    int checked_running;    /* (settable depends on running) */
     int nrec;
     Record *rec;
     const Model *model;
@@ -49,6 +53,8 @@ struct Instance {
     int running;            /* after initialization: parameters fixed */
     int stale;              /* outputs to evaluate before they are read */
     int suspect;            /* inputs set since the last check may be non-finite */
+    int fixed_finite;       /* the parameters and calculated parameters are finite (checked when they are fixed) */
+    int clean;              /* every value is known finite: fmi2GetReal copies without checking */
     int changed;            /* inputs or parameters changed since the model's last evaluation (it clears it) */
     int has_next;
     double next_time;       /* where the next fmi2DoStep must start */

@@ -79,20 +79,21 @@ static const double ZERO6[6] = {0};
 
 typedef struct {
     int refs[4];
-    double attitude[3], R[9];
+    double attitude[3];   /* the attitude m.R was computed for */
     int has_R;
+    HfMotion m;           /* (kept here, filled in place: no copy of R per evaluation) */
 } Side;
 
-static void motion_of(const Instance *inst, Side *s, HfMotion *m) {
+static const HfMotion *motion_of(const Instance *inst, Side *s) {
     const double *v = inst->values, *att = v + s->refs[1];
     if (!s->has_R || memcmp(att, s->attitude, sizeof s->attitude) != 0) {
         memcpy(s->attitude, att, sizeof s->attitude);
-        hf_rotation(att, s->R);
+        hf_rotation(att, s->m.R);
         s->has_R = 1;
     }
-    memcpy(m->R, s->R, sizeof s->R);
-    m->attitude = att;
-    hf_motion(m, v + s->refs[0], NULL, v + s->refs[2], s->refs[3] >= 0 ? v + s->refs[3] : ZERO6);
+    s->m.attitude = att;
+    hf_motion(&s->m, v + s->refs[0], NULL, v + s->refs[2], s->refs[3] >= 0 ? v + s->refs[3] : ZERO6);
+    return &s->m;
 }
 
 /* -- retardation memory seen through FMI (slave.FeedthroughMemory) ----------------------- */
@@ -276,41 +277,43 @@ static void load_evaluate(Instance *inst) {
      * (a master reading the outputs) only the memories move */
     int inputs_set = inst->changed || !L->effects_done;   /* (fmu.c has checked the inputs) */
     inst->changed = 0;
-    double *v = inst->values, total[6] = {0}, out[6], m6[36], extra[6];
-    HfMotion m;
+    /* (each load written straight into its outputs: a small array copied there just after
+     * its scalar stores would stall the copy's loads) */
+    double *v = inst->values, m6[36], extra[6];
+    const HfMotion *m = NULL;
     const HfEnv *env = NULL;
-    if (inputs_set && L->neffects) motion_of(inst, &L->motion, &m), env = env_now(inst, &L->env);
+    if (inputs_set && L->neffects) m = motion_of(inst, &L->motion), env = env_now(inst, &L->env);
     for (int k = 0; k < L->neffects && inputs_set; k++) {   /* BodyLoads.effect_loads */
         const Effect *e = &L->effects[k];
+        double *out = v + e->out;
         if (e->kind == HYDROSTATICS) {
-            hf_hydrostatics(e->params, &m, out);
+            hf_hydrostatics(e->params, m, out);
         } else if (e->kind == DRAG) {
-            hf_viscous_drag(e->params + 1, e->params[0] != 0.0, &m, env, out);
+            hf_viscous_drag(e->params + 1, e->params[0] != 0.0, m, env, out);
         } else if (e->kind == POLAR) {
-            hf_current_polar(e->params, &m, env, out);
+            hf_current_polar(e->params, m, env, out);
         } else {
-            hf_lumped_load(e->params, &m, env, out);
+            hf_lumped_load(e->params, m, env, out);
             if (hf_lumped_uses_acceleration(e->params)) {
                 if (L->explicit_) {
-                    hf_lumped_mass_matrix(e->params, &m, m6);
-                    minus_product(out, m6, m.acceleration);
+                    hf_lumped_mass_matrix(e->params, m, m6);
+                    minus_product(out, m6, m->acceleration);
                 }
-                hf_lumped_velocity_load(e->params, &m, extra);
+                hf_lumped_velocity_load(e->params, m, extra);
                 for (int i = 0; i < 6; i++) out[i] += extra[i];
             }
         }
-        memcpy(v + e->out, out, sizeof out);
     }
     L->effects_done = 1;
     for (int k = 0; k < L->ncouplings; k++) {
         Coupling *c = &L->couplings[k];
-        memset(out, 0, sizeof out);
+        double *out = v + c->out;
+        for (int i = 0; i < 6; i++) out[i] = 0.0;
         if (c->memory.kind && memory_force(&c->memory, v + c->velocity, out)) {
             hf_set_error(inst, "out of memory in the retardation memory");
             return;
         }
         if (c->acceleration >= 0) minus_product(out, c->mass, v + c->acceleration);
-        memcpy(v + c->out, out, sizeof out);
     }
     if (L->waves && inst->running) {   /* a function of time only: the current communication point */
         double w[7];
@@ -322,12 +325,13 @@ static void load_evaluate(Instance *inst) {
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }
+    double *total = v + L->total;
+    for (int i = 0; i < 6; i++) total[i] = 0.0;
     for (int k = 0; k < L->neffects; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->effects[k].out + i];
     for (int k = 0; k < L->ncouplings; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->couplings[k].out + i];
     for (int i = 0; i < 6 && L->waves; i++) total[i] += v[L->wave_force + i];
-    memcpy(v + L->total, total, sizeof total);
 }
 
 static void load_step(Instance *inst, double t, double dt) {
@@ -416,19 +420,17 @@ static void connector_start(Instance *inst) { inst->stale = 1; }
 static void connector_evaluate(Instance *inst) {
     Connector *C = inst->data;   /* (fmu.c has checked the inputs) */
     double *v = inst->values, la[6], lb[6], gap[3], theta[3], node[6], m6[36];
-    HfMotion a, b;
-    motion_of(inst, &C->a, &a);
-    if (C->has_b) motion_of(inst, &C->b, &b);
+    const HfMotion *a = motion_of(inst, &C->a), *b = C->has_b ? motion_of(inst, &C->b) : NULL;
     const HfEnv *env = env_now(inst, &C->env);
-    hf_joint(C->joint, &a, C->has_b ? &b : NULL, la, lb, gap, theta);
-    hf_lumped_load(C->node, &a, env, node);   /* BallJoint: the node's loads on A */
+    hf_joint(C->joint, a, b, la, lb, gap, theta);
+    hf_lumped_load(C->node, a, env, node);   /* BallJoint: the node's loads on A */
     for (int i = 0; i < 6; i++) la[i] += node[i];
     if (hf_lumped_uses_acceleration(C->node)) {
         if (C->explicit_) {
-            hf_lumped_mass_matrix(C->node, &a, m6);
-            minus_product(la, m6, a.acceleration);
+            hf_lumped_mass_matrix(C->node, a, m6);
+            minus_product(la, m6, a->acceleration);
         }
-        hf_lumped_velocity_load(C->node, &a, node);
+        hf_lumped_velocity_load(C->node, a, node);
         for (int i = 0; i < 6; i++) la[i] += node[i];
     }
     memcpy(v + C->force_a, la, sizeof la);

@@ -35,9 +35,23 @@ typedef struct {
 void hf_motion(HfMotion *m, const double *position, const double *attitude, const double *velocity,
                const double *acceleration);
 void hf_rotation(const double *attitude, double *R);
-void hf_rotate(const double *R, const double *x, double *out);        /* R x */
-void hf_rotate_back(const double *R, const double *x, double *out);   /* R^T x */
-void hf_cross(const double *a, const double *b, double *out);
+/* R x, R^T x and a x b (here, inline: every kernel calls them, several times a step) */
+static inline void hf_rotate(const double *R, const double *x, double *out) {
+    double a = x[0], b = x[1], c = x[2];
+    out[0] = R[0] * a + R[1] * b + R[2] * c;
+    out[1] = R[3] * a + R[4] * b + R[5] * c;
+    out[2] = R[6] * a + R[7] * b + R[8] * c;
+}
+static inline void hf_rotate_back(const double *R, const double *x, double *out) {
+    double a = x[0], b = x[1], c = x[2];
+    out[0] = R[0] * a + R[3] * b + R[6] * c;
+    out[1] = R[1] * a + R[4] * b + R[7] * c;
+    out[2] = R[2] * a + R[5] * b + R[8] * c;
+}
+static inline void hf_cross(const double *a, const double *b, double *out) {
+    double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x, out[1] = y, out[2] = z;
+}
 void hf_point_mass_matrix(const double *mass3, const double *r, double *m6);
 void hf_current_components(double speed, double direction_deg, double *out);
 
@@ -89,11 +103,11 @@ typedef struct {
     const double *mu_re, *mu_im, *gam_re, *gam_im, *inp, *out;
     double *z;                   /* 2m: (re, im) per mode */
     double v[6], force[6];       /* velocity and load at the current time */
-    double dt, *coef;            /* the last step's coefficients: 6 per mode (e, b_old, b_new) */
+    double dt, *coef;            /* the last step's coefficients: 8 per mode (e, b_old, b_new, gam) */
     double *base;                /* e z + b_old v of the step from the state now (2m; has_base) */
     int *io;                     /* inp and out as integers (2m) */
     int has_base;
-    double *pz, pv[6], pforce[6], pdt;   /* the last peek */
+    double pv[6], pforce[6], pdt;   /* the last peek: its velocity, load and step */
     int peeked;
 } HfStateSpace;
 

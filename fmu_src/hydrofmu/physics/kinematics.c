@@ -26,25 +26,6 @@ void hf_motion(HfMotion *m, const double *position, const double *attitude, cons
     }
 }
 
-void hf_rotate(const double *R, const double *x, double *out) {
-    double a = x[0], b = x[1], c = x[2];
-    out[0] = R[0] * a + R[1] * b + R[2] * c;
-    out[1] = R[3] * a + R[4] * b + R[5] * c;
-    out[2] = R[6] * a + R[7] * b + R[8] * c;
-}
-
-void hf_rotate_back(const double *R, const double *x, double *out) {
-    double a = x[0], b = x[1], c = x[2];
-    out[0] = R[0] * a + R[3] * b + R[6] * c;
-    out[1] = R[1] * a + R[4] * b + R[7] * c;
-    out[2] = R[2] * a + R[5] * b + R[8] * c;
-}
-
-void hf_cross(const double *a, const double *b, double *out) {
-    double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x, out[1] = y, out[2] = z;
-}
-
 /* M6 = [[M, -M S], [S M, -S M S]], S = [r]x (kinematics.point_mass_matrix) */
 void hf_point_mass_matrix(const double *mass3, const double *r, double *m6) {
     double S[9] = {0.0, -r[2], r[1], r[2], 0.0, -r[0], -r[1], r[0], 0.0}, MS[9], SM[9], SMS[9];

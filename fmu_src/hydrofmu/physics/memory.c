@@ -30,6 +30,9 @@ static void phi(double complex x, double complex *p1, double complex *p2) {
     *p2 = (em - x) / (x * x);
 }
 
+/* per mode in ss->coef: the step's e, b_old, b_new (re, im each), then gamma (re, im) */
+enum { COEF = 8 };
+
 int hf_ss_init(HfStateSpace *ss, const double *params, int n) {
     memset(ss, 0, sizeof *ss);
     if (n < 1) return -1;
@@ -39,12 +42,11 @@ int hf_ss_init(HfStateSpace *ss, const double *params, int n) {
     ss->mu_re = params + 1, ss->mu_im = ss->mu_re + m, ss->gam_re = ss->mu_im + m, ss->gam_im = ss->gam_re + m;
     ss->inp = ss->gam_im + m, ss->out = ss->inp + m;
     ss->z = calloc(2 * (size_t)m + 1, sizeof(double));
-    ss->pz = calloc(2 * (size_t)m + 1, sizeof(double));
-    ss->coef = calloc(6 * (size_t)m + 1, sizeof(double));
+    ss->coef = calloc(COEF * (size_t)m + 1, sizeof(double));
     ss->base = calloc(2 * (size_t)m + 1, sizeof(double));
     ss->io = calloc(2 * (size_t)m + 1, sizeof(int));
     ss->dt = -1.0;
-    if (!ss->z || !ss->pz || !ss->coef || !ss->base || !ss->io) return -1;
+    if (!ss->z || !ss->coef || !ss->base || !ss->io) return -1;
     for (int k = 0; k < m; k++) {
         ss->io[2 * k] = (int)ss->inp[k], ss->io[2 * k + 1] = (int)ss->out[k];
         if (ss->io[2 * k] < 0 || ss->io[2 * k] > 5 || ss->io[2 * k + 1] < 0 || ss->io[2 * k + 1] > 5) return -1;
@@ -53,8 +55,8 @@ int hf_ss_init(HfStateSpace *ss, const double *params, int n) {
 }
 
 void hf_ss_free(HfStateSpace *ss) {
-    free(ss->z), free(ss->pz), free(ss->coef), free(ss->base), free(ss->io);
-    ss->z = ss->pz = ss->coef = ss->base = NULL;
+    free(ss->z), free(ss->coef), free(ss->base), free(ss->io);
+    ss->z = ss->coef = ss->base = NULL;
     ss->io = NULL;
 }
 
@@ -63,58 +65,89 @@ void hf_ss_restart(HfStateSpace *ss, const double *v) {
     ss->peeked = ss->has_base = 0;
 }
 
-/* The step's state into pz and load into pforce, nothing moved.  The part that does not
- * depend on the velocity at the step's end (e z + b_old v_old) is kept until the state moves:
- * the peeks of one step (the read after fmi2DoStep, the next fmi2DoStep with new inputs)
- * share it, the same sums in the same order as one expression. */
+/* The coefficients of a step of length dt (a constant step: computed once). */
+static void ss_coefficients(HfStateSpace *ss, double dt) {
+    for (int k = 0; k < ss->m; k++) {
+        double complex x = (ss->mu_re[k] + I * ss->mu_im[k]) * dt, p1, p2;
+        phi(x, &p1, &p2);
+        double complex e = cexp(x), bo = dt * (p1 - p2), bn = dt * p2;
+        double *c = ss->coef + COEF * k;
+        c[0] = creal(e), c[1] = cimag(e), c[2] = creal(bo), c[3] = cimag(bo), c[4] = creal(bn), c[5] = cimag(bn);
+        c[6] = ss->gam_re[k], c[7] = ss->gam_im[k];
+    }
+    ss->dt = dt;
+    ss->has_base = 0;
+}
+
+/* The part of the step from the state now that does not depend on the velocity at the step's
+ * end (e z + b_old v_old), kept until the state moves: the peeks of one step (the read after
+ * fmi2DoStep, the next fmi2DoStep with new inputs) share it. */
+static void ss_base(HfStateSpace *ss) {
+    for (int k = 0; k < ss->m; k++) {
+        const double *c = ss->coef + COEF * k;
+        double zr = ss->z[2 * k], zi = ss->z[2 * k + 1], vo = ss->v[ss->io[2 * k]];
+        ss->base[2 * k] = c[0] * zr - c[1] * zi + c[2] * vo;
+        ss->base[2 * k + 1] = c[1] * zr + c[0] * zi + c[3] * vo;
+    }
+    ss->has_base = 1;
+}
+
+static void ss_prepare(HfStateSpace *ss, double dt) {
+    if (dt != ss->dt) ss_coefficients(ss, dt);
+    if (!ss->has_base) ss_base(ss);
+}
+
+/* The load at the step's end into pforce, nothing moved. */
 static void ss_step(HfStateSpace *ss, double dt, const double *v) {
-    int m = ss->m;
-    if (dt != ss->dt) {   /* coefficients of a new step length (a constant step: once) */
-        for (int k = 0; k < m; k++) {
-            double complex x = (ss->mu_re[k] + I * ss->mu_im[k]) * dt, p1, p2;
-            phi(x, &p1, &p2);
-            double complex e = cexp(x), bo = dt * (p1 - p2), bn = dt * p2;
-            double *c = ss->coef + 6 * k;
-            c[0] = creal(e), c[1] = cimag(e), c[2] = creal(bo), c[3] = cimag(bo), c[4] = creal(bn), c[5] = cimag(bn);
-        }
-        ss->dt = dt;
-        ss->has_base = 0;
-    }
-    if (!ss->has_base) {
-        for (int k = 0; k < m; k++) {
-            const double *c = ss->coef + 6 * k;
-            double zr = ss->z[2 * k], zi = ss->z[2 * k + 1], vo = ss->v[ss->io[2 * k]];
-            ss->base[2 * k] = c[0] * zr - c[1] * zi + c[2] * vo;
-            ss->base[2 * k + 1] = c[1] * zr + c[0] * zi + c[3] * vo;
-        }
-        ss->has_base = 1;
-    }
-    double f[6] = {0};
-    for (int k = 0; k < m; k++) {
-        const double *c = ss->coef + 6 * k;
+    ss_prepare(ss, dt);
+    double *f = ss->pforce;
+    if (ss->m)
+        for (int i = 0; i < 6; i++) f[i] = 0.0;
+    else
+        memcpy(f, ss->force, sizeof ss->force);
+    for (int k = 0; k < ss->m; k++) {
+        const double *c = ss->coef + COEF * k;
         double vn = v[ss->io[2 * k]];
         double nr = ss->base[2 * k] + c[4] * vn, ni = ss->base[2 * k + 1] + c[5] * vn;
-        ss->pz[2 * k] = nr, ss->pz[2 * k + 1] = ni;
-        f[ss->io[2 * k + 1]] += -ss->gam_re[k] * nr + ss->gam_im[k] * ni;
+        f[ss->io[2 * k + 1]] += -c[6] * nr + c[7] * ni;
     }
-    for (int i = 0; i < 6; i++) ss->pforce[i] = m ? f[i] : ss->force[i];
     memcpy(ss->pv, v, sizeof ss->pv);
     ss->pdt = dt;
     ss->peeked = 1;
 }
 
 void hf_ss_peek(HfStateSpace *ss, double dt, const double *v, double *force) {
-    ss_step(ss, dt, v);
+    if (!ss->peeked || ss->pdt != dt || memcmp(ss->pv, v, sizeof ss->pv) != 0) ss_step(ss, dt, v);
     memcpy(force, ss->pforce, sizeof ss->pforce);
 }
 
+/* One pass over the modes: the state at the step's end (what ss_step peeks, the same sums in the
+ * same order), the next step's base from it (that step starts from this velocity) and the load
+ * at the end of a next step of the same length with this velocity held, which is what a master
+ * reads after fmi2DoStep before it sets new inputs.  (Sums straight into the struct: small
+ * arrays copied after scalar stores stall the copy's loads.) */
 void hf_ss_advance(HfStateSpace *ss, double dt, const double *v) {
-    if (!ss->peeked || ss->pdt != dt || memcmp(ss->pv, v, sizeof ss->pv) != 0) ss_step(ss, dt, v);
-    double *t = ss->z;
-    ss->z = ss->pz, ss->pz = t;
-    memcpy(ss->v, ss->pv, sizeof ss->v);
-    memcpy(ss->force, ss->pforce, sizeof ss->force);
-    ss->peeked = ss->has_base = 0;
+    ss_prepare(ss, dt);
+    double *now = ss->force, *next = ss->pforce;
+    if (ss->m)
+        for (int i = 0; i < 6; i++) now[i] = next[i] = 0.0;
+    else
+        memcpy(next, now, sizeof ss->pforce);
+    for (int k = 0; k < ss->m; k++) {
+        const double *c = ss->coef + COEF * k;
+        double vn = v[ss->io[2 * k]];
+        double zr = ss->base[2 * k] + c[4] * vn, zi = ss->base[2 * k + 1] + c[5] * vn;
+        double br = c[0] * zr - c[1] * zi + c[2] * vn, bi = c[1] * zr + c[0] * zi + c[3] * vn;
+        double pr = br + c[4] * vn, pi = bi + c[5] * vn;
+        int out = ss->io[2 * k + 1];
+        ss->z[2 * k] = zr, ss->z[2 * k + 1] = zi;
+        ss->base[2 * k] = br, ss->base[2 * k + 1] = bi;
+        now[out] += -c[6] * zr + c[7] * zi;
+        next[out] += -c[6] * pr + c[7] * pi;
+    }
+    for (int i = 0; i < 6; i++) ss->v[i] = ss->pv[i] = v[i];
+    ss->pdt = dt;
+    ss->peeked = ss->has_base = 1;
 }
 
 size_t hf_ss_state_size(const HfStateSpace *ss) { return 2 * (size_t)ss->m + 12; }

@@ -13,12 +13,10 @@ void hf_viscous_drag(const double *matrix, int relative, const HfMotion *m, cons
     }
     hf_rotate_back(m->R, v, w);
     hf_rotate_back(m->R, m->velocity + 3, w + 3);
-    for (int i = 0; i < 6; i++) q[i] = w[i] * fabs(w[i]);
-    for (int i = 0; i < 6; i++) {
-        double s = 0.0;
-        for (int j = 0; j < 6; j++) s += matrix[6 * i + j] * q[j];
-        f[i] = -s;
-    }
+    for (int i = 0; i < 6; i++) q[i] = w[i] * fabs(w[i]), f[i] = 0.0;
+    for (int j = 0; j < 6; j++)   /* (column by column: six independent sums, each in row order) */
+        for (int i = 0; i < 6; i++) f[i] += matrix[6 * i + j] * q[j];
+    for (int i = 0; i < 6; i++) f[i] = -f[i];
     hf_rotate(m->R, f, out);
     hf_rotate(m->R, f + 3, out + 3);
 }
