@@ -624,6 +624,24 @@ def test_native_floor_copies_its_inputs_and_times_in_the_c_host(tmp_path):
     s.freeInstance()
     (row,) = bench.compare({"floor": fmu}, fmu, tmp_path / "t", rounds=1, steps=1000, best_of=1)
     assert 0.0 < row["startup_ms"] < 1e3 and 0.0 < row["step_us"] < 1e3 and row["step_x"] > 0.0
+    assert row["ports"] == (6, 6)
+    # a copy FMU of other port counts (y[k] = u[k mod 3]), and a candidate stepped on some ports only
+    copy = bench.build_floor(tmp_path / "copy", 3, 5)
+    with zipfile.ZipFile(copy) as z:
+        z.extractall(tmp_path / "c")
+    md, s = compiled_slave(copy, tmp_path / "c")
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    s.setReal([refs[f"u[{i}]"] for i in range(1, 4)], [1.0, 2.0, 3.0])
+    s.doStep(0.0, 0.1)
+    assert s.getReal([refs[f"y[{i}]"] for i in range(1, 6)]) == [1.0, 2.0, 3.0, 1.0, 2.0]
+    s.terminate()
+    s.freeInstance()
+    (row,) = bench.compare({"some ports": (copy, True, (["u[1]", "u[2]"], ["y[5]"]))}, fmu, tmp_path / "t2",
+                           rounds=1, steps=1000, best_of=1)
+    assert row["ports"] == (2, 1) and row["step_us"] > 0.0
 
 
 def test_every_effect_kernel_has_a_compiled_twin(tmp_path):

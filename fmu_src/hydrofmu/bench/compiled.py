@@ -21,8 +21,10 @@ from . import native
 from .floor import NOISY, STARTUP_BEST, spread
 
 
-def build_floor(folder) -> Path:
-    """The native floor FMU (``hydrofmu_cfloor.fmu``) in ``folder``."""
+def build_floor(folder, n_in=6, n_out=6) -> Path:
+    """The native floor FMU (``hydrofmu_cfloor.fmu``; 6 inputs, 6 outputs) in ``folder``, or a
+    copy FMU with other port counts (output k copies input k mod n_in): what exchanging that
+    many values costs on the same FMI layer, with no physics."""
     from pythonfmu import Fmi2Causality, Fmi2Slave, Real
     from ..fmi.cbuild import write_fmu
 
@@ -33,8 +35,8 @@ def build_floor(folder) -> Path:
 
         def __init__(self, **kwargs):
             super().__init__(**kwargs)
-            for name, causality in (("u", Fmi2Causality.input), ("y", Fmi2Causality.output)):
-                for i in range(6):
+            for name, causality, n in (("u", Fmi2Causality.input, n_in), ("y", Fmi2Causality.output, n_out)):
+                for i in range(n):
                     self.register_variable(Real(f"{name}[{i + 1}]", causality=causality, getter=lambda: 0.0,
                                                 **({"setter": lambda v: None} if name == "u" else {})))
 
@@ -42,22 +44,32 @@ def build_floor(folder) -> Path:
             return True
 
     slave = Floor(instance_name="floor")
-    slave._start = [0.0] * 12   # (the start values hydrofmu's slaves keep)
-    recs = [("kind", [3]), ("start", [0.0] * 12), ("copy", list(range(12)))]
-    return write_fmu(Path(folder) / "hydrofmu_cfloor.fmu", slave, recs)
+    slave._start = [0.0] * (n_in + n_out)   # (the start values hydrofmu's slaves keep)
+    recs = [("kind", [3]), ("start", [0.0] * (n_in + n_out)),
+            ("copy", [k % n_in for k in range(n_out)] + [n_in + k for k in range(n_out)])]
+    name = "hydrofmu_cfloor" if (n_in, n_out) == (6, 6) else f"hydrofmu_copy_{n_in}_{n_out}"
+    return write_fmu(Path(folder) / f"{name}.fmu", slave, recs)
+
+
+def _candidate(f):
+    """(FMU, vary, (inputs, outputs)) of a candidate given as an FMU, (FMU, vary) or (FMU, vary, ports)."""
+    f = f if isinstance(f, tuple) else (f, False)
+    return f if len(f) == 3 else (*f, (None, None))
 
 
 def compare(candidates, floor_fmu, out, rounds=5, steps=200_000, dt=0.05, best_of=STARTUP_BEST):
-    """{label: compiled FMU, or (FMU, vary)} against the native floor in the C timing host, both
-    with the same inputs every step or (vary) inputs that change at every step (native_host.c);
-    rows {label, step_us, step_floor_us, step_x, startup_ms, startup_floor_ms, startup_x,
-    *_spread, *_noisy}."""
+    """{label: compiled FMU, or (FMU, vary), or (FMU, vary, (inputs, outputs))} against the native
+    floor in the C timing host, both with the same inputs every step or (vary) inputs that change
+    at every step (native_host.c); every input set and every output read, or only the ports whose
+    names start with one of ``inputs`` / ``outputs`` (None: all); rows {label, step_us,
+    step_floor_us, step_x, startup_ms, startup_floor_ms, startup_x, *_spread, *_noisy, ports}."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     exe = native.host(out)
     floor_args = native.unpack(floor_fmu, out / "floor")
-    candidates = {label: f if isinstance(f, tuple) else (f, False) for label, f in candidates.items()}
-    unpacked = {label: (native.unpack(f, out / f"c{k}"), vary) for k, (label, (f, vary)) in enumerate(candidates.items())}
+    candidates = {label: _candidate(f) for label, f in candidates.items()}
+    unpacked = {label: (native.unpack(f, out / f"c{k}", *ports), vary)
+                for k, (label, (f, vary, ports)) in enumerate(candidates.items())}
 
     def measure(args, vary):
         """(startup [s], seconds per step), each the best of ``best_of`` fresh processes (noise
@@ -80,13 +92,14 @@ def compare(candidates, floor_fmu, out, rounds=5, steps=200_000, dt=0.05, best_o
                      "startup_ms": 1e3 * float(np.median(t[:, 1])), "startup_floor_ms": 1e3 * float(np.median(t[:, 0])),
                      "startup_x": float(np.median(start_x)),
                      "step_spread": spread(step_x), "step_noisy": spread(step_x) > NOISY,
-                     "startup_spread": spread(start_x), "startup_noisy": spread(start_x) > NOISY})
+                     "startup_spread": spread(start_x), "startup_noisy": spread(start_x) > NOISY,
+                     "ports": (unpacked[label][0][3].count(":"), len(unpacked[label][0][4].split(",")))})
     return rows
 
 
 def design_scene(folder) -> Path:
-    """models/side_by_side.toml with AQWA viscous drag on barge_a: its load FMU has
-    state-space memories (own and cross) and drag, the FMU the target speaks of."""
+    """models/side_by_side.toml with AQWA viscous drag on barge_a: its load FMU has the current
+    polar, drag and state-space memories (own and cross), more than the target names."""
     models = Path(__file__).resolve().parents[3] / "models"
     text = (models / "side_by_side.toml").read_text().replace('deck = "decks/', f'deck = "{models.as_posix()}/decks/')
     text += f"""
@@ -101,6 +114,42 @@ body = "BARGE"
     return path
 
 
+def target_scene(folder) -> Path:
+    """The FMU the target names and nothing else: one barge of models/side_by_side.toml with its
+    own SIMO radiation memory (state space, the design preset) and AQWA viscous drag in current."""
+    decks = (Path(__file__).resolve().parents[3] / "models" / "decks").as_posix()
+    path = Path(folder) / "drag_memory.toml"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(f"""[scene]
+name = "drag_memory"
+[environment]
+current_speed = 0.5
+current_direction = 90.0
+[run]
+preset = "design"
+stop = 10.0
+[bodies.barge]
+mass = 1.28125e7
+inertia = [7.74e8, 1.078e10, 1.134e10]
+stiffness = [2.0e5, 2.0e5, 2.513e7, 9.9e8, 2.06e10, 5.0e8]
+[[bodies.barge.effects]]
+type = "aqwa_viscous_drag"
+deck = "{decks}/barge_viscous.aqwa"
+body = "BARGE"
+[[couplings]]
+deck = "{decks}/side_by_side.sim"
+coupling = "SELFA"
+bodies = {{ BARGEA = "barge" }}
+""")
+    return path
+
+
+# the ports a master connects to a load FMU in a coupled scene (the OSP and SSP files we write):
+# the body's motion in, the total load out (the current is set once, the per-effect loads are
+# for recording)
+COUPLED = (("position", "attitude", "velocity"), ("force[",))
+
+
 def part(out, quick, pythonfmu_floor):
     """Lines of the compiled flavour's figures: the load FMU with state-space memory and drag,
     the joint and dynamics FMUs against the native floor in the C host; the two-body design
@@ -112,19 +161,28 @@ def part(out, quick, pythonfmu_floor):
     quiet = lambda *_: None   # noqa: E731
     out = Path(out) / "compiled"
     cfloor = build_floor(out)
+    target = build_scene(load_scene(target_scene(out)), out / "scenes", log=quiet, runtime="c") / "drag_memory_barge.fmu"
     drag = build_scene(load_scene(design_scene(out)), out / "scenes", log=quiet, runtime="c")
     joined = build_scene(load_scene(Path(__file__).resolve().parents[3] / "models" / "joined_barges.toml"),
                          out / "scenes", log=quiet, runtime="c")
     load = drag / "side_by_side_barge_a.fmu"
-    candidates = {"load FMU, state-space memory + drag, inputs changing every step": (load, True),
-                  "load FMU, state-space memory + drag, the same inputs every step": load,
-                  "dynamics FMU, two coupled bodies, inputs changing every step":
-                      (drag / "side_by_side_barge_a_barge_b_dynamics.fmu", True),
-                  "joint FMU (CONB), inputs changing every step": (joined / "joined_barges_hitch.fmu", True)}
+    ports = native.unpack(target, out / "ports")
+    n_in, n_out = ports[3].count(":"), len(ports[4].split(","))
+    candidates = {
+        "load FMU, state-space memory + drag, inputs changing every step": (target, True),
+        "the same FMU as coupled (motion in, total load out), inputs changing every step": (target, True, COUPLED),
+        f"copy FMU with the same ports ({n_in} in, {n_out} out): the FMI exchange alone, no physics":
+            (build_floor(out, n_in, n_out), True),
+        "side_by_side barge_a load FMU (current polar, drag, own and cross state-space memory), inputs changing "
+        "every step": (load, True),
+        "the same, the same inputs every step": load,
+        "dynamics FMU, two coupled bodies, inputs changing every step":
+            (drag / "side_by_side_barge_a_barge_b_dynamics.fmu", True),
+        "joint FMU (CONB), inputs changing every step": (joined / "joined_barges_hitch.fmu", True)}
     rows = compare(candidates, cfloor, out / "unzipped", rounds=3 if quick else 5, steps=20_000 if quick else 200_000,
                    best_of=1 if quick else STARTUP_BEST)
     f = rows[0]   # the target's: inputs that change every step, as in a co-simulation
-    lines = [f"native floor (trivial compiled FMU, C host): {f['step_floor_us']:.2f} µs per step "
+    lines = [f"native floor (trivial compiled FMU, C host): {f['step_floor_us']:.3f} µs per step "
              f"(set 6, doStep, get 6), startup {f['startup_floor_ms']:.2f} ms"]
 
     def figure(r, what, text):   # a noisy figure is said to be so, not printed
@@ -132,9 +190,14 @@ def part(out, quick, pythonfmu_floor):
         return f"{what} too noisy ({over(r[f'{what}_spread'], NOISY)}), no figure" if r[f"{what}_noisy"] else text
 
     for r in rows:
-        lines.append(f"compiled {r['label']}: " + figure(r, "step", f"{r['step_x']:.1f}× the native floor per step "
-                                                                   f"({r['step_us']:.2f} µs)")
+        lines.append(f"compiled {r['label']} [set {r['ports'][0]}, get {r['ports'][1]}]: "
+                     + figure(r, "step", f"{r['step_x']:.1f}× the native floor per step ({1e3 * r['step_us']:.0f} ns)")
                      + "; " + figure(r, "startup", f"{r['startup_x']:.1f}× at startup ({r['startup_ms']:.2f} ms)"))
+    copy = rows[2]
+    if not (f["step_noisy"] or copy["step_noisy"]):
+        lines.append(f"of the load FMU's {1e3 * f['step_us']:.0f} ns per step, {1e3 * copy['step_us']:.0f} ns is the FMI "
+                     f"exchange of its ports and {1e3 * (f['step_us'] - copy['step_us']):.0f} ns its physics "
+                     f"({(f['step_us'] - copy['step_us']) / f['step_floor_us']:.1f}× the whole floor step)")
     met = lambda x: "met" if x <= 3.0 else "NOT met"   # noqa: E731
     for key, what in (("step", "per step"), ("startup", "at startup")):
         if not f[f"{key}_noisy"]:

@@ -75,16 +75,20 @@ def host(folder) -> Path:
     return out
 
 
-def unpack(fmu, folder):
+def unpack(fmu, folder, inputs=None, outputs=None):
     """Unzip ``fmu`` into ``folder``; returns (folder, model identifier, guid, inputs "vr:value,…",
-    outputs "vr,…"): every Real input at its start value (0 without one), every Real output."""
+    outputs "vr,…"): every Real input at its start value (0 without one), every Real output, or
+    only those whose names start with one of ``inputs`` / ``outputs`` (the ports a master
+    connects)."""
     from fmpy import read_model_description
     md = read_model_description(str(fmu))
     with zipfile.ZipFile(fmu) as z:
         z.extractall(folder)
+    chosen = lambda v, names: names is None or v.name.startswith(tuple(names))   # noqa: E731
     ins = ",".join(f"{v.valueReference}:{float(v.start or 0.0)!r}" for v in md.modelVariables
-                   if v.causality == "input" and v.type == "Real")
-    outs = ",".join(str(v.valueReference) for v in md.modelVariables if v.causality == "output" and v.type == "Real")
+                   if v.causality == "input" and v.type == "Real" and chosen(v, inputs))
+    outs = ",".join(str(v.valueReference) for v in md.modelVariables
+                    if v.causality == "output" and v.type == "Real" and chosen(v, outputs))
     return str(Path(folder).resolve()), md.coSimulation.modelIdentifier, md.guid, ins, outs
 
 
