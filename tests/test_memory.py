@@ -309,3 +309,28 @@ def test_advance_of_the_last_peek_equals_a_fresh_step(make):
             a.set_state(a.state())   # drops the peek
         np.testing.assert_array_equal(a.advance(dt, v, peeked=True), b.advance(dt, v))
     assert a.state() == b.state()
+
+
+def test_filling_history_weights_are_the_direct_ones():
+    """While the history fills at a constant step, the node weights come from one uniform
+    grid's half hats (Convolution._weights_of); they must equal the weights computed directly
+    for those offsets at every length, up to and past the kernel's span, and a run whose step
+    changes must fall back to the direct ones: the loads of a whole run equal those of an
+    evaluator that always computes them directly."""
+    from hydrofmu.bench.kernels import coupling_kernels, irregular_velocity
+    timdel, dt = 0.05, 0.07   # (a step that is no multiple of the kernel's spacing: pieces split)
+    c = Convolution(coupling_kernels(timdel, 120), timdel, shape=(6, 6))
+    n = int(np.ceil(c.span / dt)) + 2
+    grid = np.concatenate([[0.0], np.cumsum(np.full(n - 1, dt))])
+    full = int(np.searchsorted(grid, c.span, "left")) + 1
+    for m in (2, 3, 17, full - 1, full):
+        s = grid[:m]
+        direct = c._weights(s)
+        assert np.abs(c._weights_of(s, np.full(m - 1, dt)) - direct).max() <= 1e-13 * np.abs(direct).max(), m
+    direct = Convolution(coupling_kernels(timdel, 120), timdel, shape=(6, 6))
+    direct._weights_of = lambda s, steps: direct._weights(s)
+    steps = np.r_[np.full(150, dt), np.full(60, 0.03), np.full(150, dt)]   # fills, changes step, refills
+    v = irregular_velocity(np.cumsum(steps))
+    got = np.array([c.advance(h, vk) for h, vk in zip(steps, v)])
+    ref = np.array([direct.advance(h, vk) for h, vk in zip(steps, v)])
+    assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()

@@ -90,3 +90,24 @@ def growth(lag_counts=(100, 300, 1000, 3000, 10000), timdel=0.05, tol=0.01, call
                      "states": cands["state_space"].order,
                      **{f"{name}_spread": float(np.ptp(t) / np.median(t)) for name, t in times.items()}})
     return rows
+
+
+def filling(lags=2000, timdel=0.05, steady=200, repeats=3):
+    """{lags, filling_us, steady_us, ratio}: the full convolution's cost per step while its
+    history fills (the first memory length, each step's offsets new: the node weights come
+    from the grid's half hats, ``Convolution._weights_of``) against once it is full (the same
+    offsets every step: cached weights), medians over the steps, the best of ``repeats``
+    fresh evaluators."""
+    import time
+    kernels = coupling_kernels(timdel, lags)
+    v = irregular_velocity(timdel * np.arange(lags + steady + 2))
+    Convolution(kernels, timdel, shape=(6, 6)).advance(timdel, v[1])   # (imports and first calls)
+    fill, full = [], []
+    for _ in range(repeats):
+        ev, t = Convolution(kernels, timdel, shape=(6, 6), v0=v[0]), []
+        for vk in v[1:]:
+            t0 = time.perf_counter()
+            ev.advance(timdel, vk)
+            t.append(time.perf_counter() - t0)
+        fill.append(np.median(t[1:lags])), full.append(np.median(t[lags + 1:]))
+    return {"lags": lags, "filling_us": 1e6 * min(fill), "steady_us": 1e6 * min(full), "ratio": min(fill) / min(full)}

@@ -100,8 +100,12 @@ def part_memory(out, quick):
     best = max(good, key=lambda r: r["cheaper"]) if good else None
     lines = [f"state-space vs full convolution at dt = TIMDEL: {best['cheaper']:.1f}× cheaper at "
              f"{100 * best['error']:.2f} % error ({best['knob']})" if best else "no state-space fit within 1 %"]
-    return lines + ([f"at dt = TIMDEL/2: {half[-1]['cheaper']:.1f}× cheaper at {100 * half[-1]['error']:.2f} % error"]
-                    if half else [])
+    lines += [f"at dt = TIMDEL/2: {half[-1]['cheaper']:.1f}× cheaper at {100 * half[-1]['error']:.2f} % error"] if half else []
+    for lags in (400,) if quick else (600, 2000):
+        f = memory_cost.filling(lags, repeats=1 if quick else 3)
+        lines.append(f"full convolution, {lags} lags, while its history fills: {f['filling_us']:.0f} µs per step, "
+                     f"{f['ratio']:.2f}× its cost once full ({f['steady_us']:.0f} µs)")
+    return lines
 
 
 def plot_memory_tradeoff(rows, path):

@@ -124,6 +124,8 @@ typedef struct {
     double *key, *w;             /* cached node offsets and their weights (nkey x nelem) */
     int nkey, wcap;
     double *s;                   /* scratch offsets */
+    double grid_dt, *grid, *right, *left;   /* a uniform grid of step grid_dt (0: none), its nodes' half hats */
+    int ngrid;
     double pforce[6], pv[6], pdt;
     int plo, peeked;
 } HfConvolution;

@@ -185,8 +185,9 @@ int hf_conv_init(HfConvolution *cv, const double *params, int n) {
 }
 
 void hf_conv_free(HfConvolution *cv) {
-    free(cv->v), free(cv->dt), free(cv->key), free(cv->w), free(cv->s);
-    cv->v = cv->dt = cv->key = cv->w = cv->s = NULL;
+    free(cv->v), free(cv->dt), free(cv->key), free(cv->w), free(cv->s), free(cv->grid), free(cv->right), free(cv->left);
+    cv->v = cv->dt = cv->key = cv->w = cv->s = cv->grid = cv->right = cv->left = NULL;
+    cv->grid_dt = 0.0, cv->ngrid = 0;
 }
 
 void hf_conv_restart(HfConvolution *cv, const double *v) {
@@ -225,11 +226,13 @@ static int upper(const double *a, int n, double x) {   /* searchsorted(a, x, 'ri
 
 /* W[k, e] = int h_e(sigma) phi_k(sigma) dsigma, phi_k the hat function of node offset s_k
  * (memory.Convolution._weights): on every piece between the merged breakpoints of s and g,
- * h and the two hats are linear, so the integral is exact. */
-static void weights(HfConvolution *cv, const double *s, int ns, double *w) {
+ * h and the two hats are linear, so the integral is exact.  The part over [s_k, s_k+1] goes
+ * to right, the part over [s_k-1, s_k] to left: the same array for W, two for the halves. */
+static void weights(HfConvolution *cv, const double *s, int ns, double *right, double *left) {
     const double *g = cv->g;
     int ng = cv->nseg + 1, ne = cv->nelem, nseg = cv->nseg;
-    memset(w, 0, sizeof(double) * ns * ne);
+    memset(right, 0, sizeof(double) * ns * ne);
+    memset(left, 0, sizeof(double) * ns * ne);
     double top = fmin(s[ns - 1], g[ng - 1]);
     int i = 0, j = 0, have = 0;
     double prev_raw = 0.0, a = 0.0;   /* the last point of the union (before merging twins), the last kept */
@@ -259,13 +262,47 @@ static void weights(HfConvolution *cv, const double *s, int ns, double *w) {
         double kl = (1 - aa) * na + (1 - ab) * nb, kr = aa * na + ab * nb;
         double fl = (1 - aa) * fa + (1 - ab) * fb, fr = aa * fa + ab * fb;
         const double *hl = cv->hl + js * ne, *hr = cv->hr + js * ne;
-        double *wk = w + k * ne, *wf = w + (k + 1) * ne;
+        double *wk = right + k * ne, *wf = left + (k + 1) * ne;
         for (int e = 0; e < ne; e++) {
             wk[e] += kl * hl[e] + kr * hr[e];
             wf[e] += fl * hl[e] + fr * hr[e];
         }
         a = b;
     }
+}
+
+/* The weights of offsets s (ns nodes, steps dt[hi - 1], dt[hi - 2], ...) into cv->w from the
+ * half hats of a uniform grid when every step is the same (memory.Convolution._weights_of:
+ * while the history fills, s is the start of one grid and only its last hat is cut short);
+ * -1: not such offsets (or out of memory), the caller computes them. */
+static int grid_weights(HfConvolution *cv, const double *s, int ns, int hi) {
+    double dt = cv->dt[hi - 1];
+    if (!(dt > 0.0)) return -1;
+    for (int k = 1; k < ns; k++)
+        if (cv->dt[hi - k] != dt) return -1;
+    int ne = cv->nelem;
+    if (cv->grid_dt != dt) {
+        int n = (int)ceil(cv->span / dt) + 2;   /* nodes of a full history, and one */
+        double *grid = realloc(cv->grid, sizeof(double) * n);
+        if (!grid) return -1;
+        cv->grid = grid;
+        grid[0] = 0.0;
+        for (int k = 1; k < n; k++) grid[k] = grid[k - 1] + dt;   /* (the sums evaluate makes) */
+        int m = 0;   /* searchsorted(grid, span, 'left') + 1 */
+        while (m < n && grid[m] < cv->span) m++;
+        m = m + 1 < n ? m + 1 : n;
+        double *right = realloc(cv->right, sizeof(double) * m * (ne ? ne : 1));
+        if (right) cv->right = right;
+        double *left = realloc(cv->left, sizeof(double) * m * (ne ? ne : 1));
+        if (left) cv->left = left;
+        if (!right || !left) return -1;
+        weights(cv, grid, m, right, left);
+        cv->grid_dt = dt, cv->ngrid = m;
+    }
+    if (ns > cv->ngrid || cv->grid[ns - 1] != s[ns - 1]) return -1;
+    for (int q = 0; q < ns * ne; q++) cv->w[q] = cv->left[q];   /* (the last node's right half: none) */
+    for (int q = 0; q < (ns - 1) * ne; q++) cv->w[q] += cv->right[q];
+    return 0;
 }
 
 /* F at node hi - 1 from the nodes lo ... hi - 1 into force; the first node still needed into *lo_out. */
@@ -294,7 +331,7 @@ static int evaluate(HfConvolution *cv, int hi, double *force, int *lo_out) {
     memset(force, 0, sizeof(double) * 6);
     if (!cv->nelem || ns < 2 || cv->span == 0.0) return 0;
     if (ns != cv->nkey || memcmp(s, cv->key, sizeof(double) * ns) != 0) {
-        weights(cv, s, ns, cv->w);
+        if (grid_weights(cv, s, ns, hi)) weights(cv, s, ns, cv->w, cv->w);
         memcpy(cv->key, s, sizeof(double) * ns);
         cv->nkey = ns;
     }

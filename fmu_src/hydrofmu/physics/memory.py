@@ -101,6 +101,7 @@ class Convolution:
         self._dt = np.zeros(64)           # _dt[k]: time from node k − 1 to node k
         self._v[0], self._lo, self._hi = v, 0, 1
         self._key = self._w = None        # cached node offsets and their weights
+        self._grid = None                 # (dt, uniform grid, right and left half-hat weights)
         self._peeked = None               # (dt, v, force, lo) of the last peek
         self.force = np.zeros(self.shape[0])
 
@@ -167,13 +168,37 @@ class Convolution:
         if not self._out.size or s.size < 2 or self.span == 0.0:
             return np.zeros(self.shape[0]), lo
         if self._key is None or self._key.shape != s.shape or not np.array_equal(self._key, s):
-            self._key, self._w = s, self._weights(s)
+            self._key, self._w = s, self._weights_of(s, self._dt[hi - 1:lo:-1])
         v = self._v[hi - 1:lo - 1 if lo else None:-1]   # newest first, like s
         f = np.einsum("ke,ke->e", self._w, v[:, self._in])
         return -np.bincount(self._out, weights=f, minlength=self.shape[0]), lo
 
-    def _weights(self, s):
-        """W[k, e] = ∫ h_e(σ)·φ_k(σ) dσ with φ_k the hat function of node k (offset s_k)."""
+    def _weights_of(self, s, steps):
+        """The node weights of offsets s, made of the step lengths ``steps`` (newest first).
+        While the history fills at a constant step, s is the start of one uniform grid and
+        only its last node's hat is cut short: the weights are the grid's, each node's two
+        half-hats computed once for the whole grid (a rebuild at every step would cost ten
+        times the weighted sum, for the first memory length)."""
+        steps = steps[:s.size - 1]   # (those of the nodes kept)
+        if steps.size and steps[0] > 0 and (steps == steps[0]).all():
+            dt = float(steps[0])
+            if self._grid is None or self._grid[0] != dt:
+                n = int(np.ceil(self.span / dt)) + 2        # nodes of a full history, and one
+                grid = np.zeros(n)
+                np.cumsum(np.full(n - 1, dt), out=grid[1:])   # (the sums _evaluate makes)
+                m = int(np.searchsorted(grid, self.span, "left")) + 1
+                self._grid = (dt, grid[:m], *self._weights(grid[:m], halves=True))
+            _, grid, right, left = self._grid
+            m = s.size
+            if m <= grid.size and grid[m - 1] == s[-1]:
+                w = left[:m].copy()   # (the last node's right half is past the offsets: none)
+                w[:m - 1] += right[:m - 1]
+                return w
+        return self._weights(s)
+
+    def _weights(self, s, halves=False):
+        """W[k, e] = ∫ h_e(σ)·φ_k(σ) dσ with φ_k the hat function of node k (offset s_k);
+        ``halves``: (the part over [s_k, s_k+1], the part over [s_k-1, s_k]) apart."""
         g, hl = self._g, self._hl
         top = min(s[-1], g[-1])
         p = np.union1d(s, g)
@@ -193,13 +218,15 @@ class Convolution:
         c = length / 6.0
         fa, fb = c * (2 * la + lb), c * (la + 2 * lb)              # far node (k + 1)
         na, nb = c * (2 * (1 - la) + 1 - lb), c * (1 - la + 2 * (1 - lb))  # near node (k)
-        rows = np.concatenate([k, k, k + 1, k + 1])
-        cols = np.concatenate([j, j + hl.shape[0], j, j + hl.shape[0]])
-        data = np.concatenate([(1 - aa) * na + (1 - ab) * nb, aa * na + ab * nb,
-                               (1 - aa) * fa + (1 - ab) * fb, aa * fa + ab * fb])
         from scipy import sparse   # here, not at import: FMUs with state-space memory never need it
-        m = sparse.csr_matrix((data, (rows, cols)), shape=(s.size, 2 * hl.shape[0]))
-        return m @ self._h2
+        cols = np.concatenate([j, j + hl.shape[0]])
+
+        def part(rows, at_a, at_b):   # S·[hl; hr], S sparse (node × segment end)
+            data = np.concatenate([(1 - aa) * at_a + (1 - ab) * at_b, aa * at_a + ab * at_b])
+            return sparse.csr_matrix((data, (np.concatenate([rows, rows]), cols)), shape=(s.size, 2 * hl.shape[0]))
+        if halves:
+            return part(k, na, nb) @ self._h2, part(k + 1, fa, fb) @ self._h2
+        return (part(k, na, nb) + part(k + 1, fa, fb)) @ self._h2
 
     C_TAG = "convolution"   # its record in a compiled FMU (memory.c)
 
