@@ -2,6 +2,7 @@
 in the FMU's description; instantiation only loads it (no SVD, no scipy, checked in a
 fresh interpreter), the runtime copy holds only what a slave imports, with its bytecode,
 and the slave imports no more (pythonfmu's builder stays out until asked for)."""
+import io
 import subprocess
 import sys
 import zipfile
@@ -53,16 +54,18 @@ def test_fits_are_stored_at_build_and_only_loaded(tmp_path):
             np.testing.assert_array_equal(f.A, ref.A)
             np.testing.assert_array_equal(f.C, ref.C)
             assert f.error == ref.error <= c.tolerance
-    # the runtime: the slave, the physics, the description and the errors, with bytecode
-    runtime = {n.split("/")[1] for n in names if n.startswith("resources/hydrofmu_rt_")}
-    assert len(runtime) == 1
-    rt = f"resources/{runtime.pop()}/"
-    held = {n[len(rt):] for n in names if n.startswith(rt) and n.endswith(".py")}
+    # the runtime (one zip, tests/test_runtime_zip.py): the slave, the physics, the description
+    # and the errors, with bytecode
+    rt = next(n for n in names if n.startswith("resources/hydrofmu_rt_") and n.endswith(".zip"))
+    with zipfile.ZipFile(fmu) as z, zipfile.ZipFile(io.BytesIO(z.read(rt))) as inner:
+        runtime = inner.namelist()
+    prefix = rt[len("resources/"):-len(".zip")] + "/"
+    held = {n[len(prefix):] for n in runtime if n.startswith(prefix) and n.endswith(".py")}
     assert {"__init__.py", "errors.py", "description.py", "fmi/slave.py", "physics/memory.py"} <= held
     assert not any(n.startswith(("scene", "decks/", "cosim/", "bench/", "cli", "assembly", "fmi/build"))
                    for n in held)
     tag = sys.implementation.cache_tag
-    assert f"{rt}physics/__pycache__/memory.{tag}.pyc" in names
+    assert f"{prefix}physics/__pycache__/memory.{tag}.pyc" in runtime
     # a fresh interpreter instantiates, initialises and steps it without an SVD or scipy
     out = subprocess.run([sys.executable, "-c", FRESH, str(tmp_path), str(fmu)], capture_output=True,
                          text=True, timeout=120)

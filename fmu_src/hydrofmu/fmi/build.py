@@ -4,10 +4,11 @@ connections, run settings, power bonds) for our masters, the OSP files for libco
 (``<model>_OspModelDescription.xml`` per FMU and OspSystemStructure.xml, fmi/osp.py) and an
 SSP file (``<scene>.ssp``, fmi/ssp.py) for any SSP importer.
 
-Each FMU is self-contained: its resources carry a copy of the hydrofmu runtime under a
-content-hashed name (two FMUs of different builds in one process never share code by
-accident), the pythonfmu runtime and its typed description (hydrofmu.description); the host
-needs only numpy.  What each FMU holds comes from ``hydrofmu.assembly``: this module only packages.
+Each FMU is self-contained: its resources carry the hydrofmu runtime under a content-hashed
+name (two FMUs of different builds in one process never share code by accident) and
+pythonfmu's slave API, both in one zip imported from memory (fmi/runtime_zip.py: an FMU
+unpacks 10 files), and its typed description (hydrofmu.description); the host needs only
+numpy.  What each FMU holds comes from ``hydrofmu.assembly``: this module only packages.
 Everything is built in a temporary folder and moved into place at the end, so a failed
 build leaves nothing half-written.
 """
@@ -85,23 +86,61 @@ def runtime_name():
     return f"hydrofmu_rt_{h.hexdigest()[:10]}"
 
 
-def copy_runtime(dest):
-    """Copy the runtime into ``dest`` (a package folder of its own), its C parts compiled."""
+# pythonfmu's modules a slave imports (its slave API): the runtime zip holds these, not its builder
+PYTHONFMU_RUNTIME = ("__init__", "_version", "default_experiment", "enums", "fmi2slave", "logmsg", "variables")
+ZIP_DATE = (1980, 1, 1, 0, 0, 0)   # the zip's time stamps: the same runtime gives the same bytes
+
+
+def pack_runtime(stage, runtime):
+    """The FMU's runtime in ``stage``: ``<runtime>.zip`` (the runtime package and pythonfmu's
+    package, each module's source and its bytecode for this Python; imported from memory by
+    fmi/runtime_zip.py) and, as files, what only loads from a file: ``<runtime>/physics/
+    _rigid.so``.  Returns both paths (the FMU's project files)."""
+    import pythonfmu.builder
     from ..cc import cached
-    for f in runtime_files():
-        (dest / f).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(PACKAGE / f, dest / f)
+    members = {f"{runtime}/{f.as_posix()}": (PACKAGE / f).read_bytes() for f in runtime_files()}
+    members[f"{runtime}/__init__.py"] = RUNTIME_INIT.encode()
+    members.update({f"pythonfmu/{m}.py": (pythonfmu.builder.HERE / f"{m}.py").read_bytes() for m in PYTHONFMU_RUNTIME})
+    tag = sys.implementation.cache_tag
+    for name, source in list(members.items()):
+        folder, _, module = name.rpartition("/")
+        if tag:   # another Python (other cache tag) compiles the sources
+            members[f"{folder}/__pycache__/{module[:-3]}.{tag}.pyc"] = bytecode(source, name)
+    archive = stage / f"{runtime}.zip"
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_STORED) as z:   # stored: the FMU's zip deflates it
+        for name in sorted(members):
+            z.writestr(zipfile.ZipInfo(name, ZIP_DATE), members[name])
+    binaries = stage / runtime
     for src, lib in RUNTIME_C.items():
-        shutil.copyfile(cached(PACKAGE / src), dest / lib)
-    (dest / "__init__.py").write_text(RUNTIME_INIT)
+        (binaries / lib).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(cached(PACKAGE / src), binaries / lib)
+    return archive, binaries
 
 
-SCRIPT = '''"""hydrofmu FMU {model_id}: {description}"""
+SCRIPT = """# hydrofmu FMU {model_id}: {description}
 # pythonfmu 0.7 executes this file again at every instantiation (in the module's globals,
 # with fresh locals) and keeps for good whatever that creates: the class is defined once
-# per runtime module (again only when a build in this process reloaded the runtime).
+# per runtime module (again only when a build in this process reloaded the runtime, or an
+# FMU of the same name from another hydrofmu version ran in between).  Names used inside
+# the class are looked up in the module's globals, which every FMU of this name shares:
+# the class carries its own runtime.
 import ctypes
+import os
 import sys
+
+# The runtime ({runtime}) and pythonfmu come from {runtime}.zip beside this file, read
+# into memory by the finder below (hydrofmu.fmi.runtime_zip), made once per process.
+_RUNTIME_ZIP = r'''{finder}'''
+
+_rz = sys.modules.get("{runtime}_zip")
+if _rz is None:
+    _rz = type(sys)("{runtime}_zip")
+    exec(compile(_RUNTIME_ZIP, "{runtime}_zip", "exec"), _rz.__dict__)
+    sys.modules["{runtime}_zip"] = _rz
+for _folder in sys.path + [os.path.dirname(os.path.abspath(__file__))]:   # pythonfmu put ours first
+    if isinstance(_folder, str) and os.path.isfile(os.path.join(_folder, "{runtime}.zip")):
+        _rz.install("{runtime}", os.path.join(_folder, "{runtime}.zip"))
+        break
 
 _runtime = globals().get("_runtime")
 if _runtime is None or sys.modules.get("{runtime}.fmi.slave") is not _runtime:
@@ -117,12 +156,16 @@ if _runtime is None or sys.modules.get("{runtime}.fmi.slave") is not _runtime:
             while sys.path.count(resources) > 1:
                 sys.path.remove(resources)
             # ... and answers an exception here by releasing objects twice: never raise
-            _slave.start(self, super().__init__, kwargs)
+            self._hydrofmu_runtime.start(self, super().__init__, kwargs)
 
+    {model_id}._hydrofmu_runtime = _slave
     globals().update({model_id}={model_id}, _runtime=_slave)
 {model_id} = globals()["{model_id}"]
-'''
+"""
 
+
+FINDER = (Path(__file__).with_name("runtime_zip.py")).read_text(encoding="utf-8")
+assert "'''" not in FINDER and not FINDER.endswith("\\"), "runtime_zip.py must fit in SCRIPT's r'''…'''"
 
 SLAVES = {description.LoadFMU: "LoadSlave", description.ConnectorFMU: "ConnectorSlave",
           description.DynamicsFMU: "DynamicsSlave"}
@@ -136,16 +179,15 @@ def build_fmu(instance, workdir, runtime, shim=True):
     model_id = instance.model_id
     stage = workdir / "stage" / model_id
     stage.mkdir(parents=True)
-    rt = stage / runtime
-    copy_runtime(rt)
+    archive, binaries = pack_runtime(stage, runtime)
     config = description.write(instance.fmu, stage)
     script = stage / f"{model_id}.py"
     script.write_text(SCRIPT.format(model_id=model_id, runtime=runtime, slave=SLAVES[type(instance.fmu)],
-                                    description=instance.fmu.description))
+                                    description=" ".join(instance.fmu.description.split()), finder=FINDER))
     saved_path = list(sys.path)
     loaded = {m for m in sys.modules if m.split(".")[0] == runtime}
     try:
-        fmu = FmuBuilder.build_FMU(script, dest=workdir / "fmus", project_files=[rt, config],
+        fmu = FmuBuilder.build_FMU(script, dest=workdir / "fmus", project_files=[archive, binaries, config],
                                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         slave = getattr(importlib.import_module(model_id), model_id)(
             instance_name="introspect", resources=str(stage))
@@ -154,10 +196,10 @@ def build_fmu(instance, workdir, runtime, shim=True):
         t0 = starts.at_start(instance.name, slave)   # here: lazy imports still find the staged runtime
     finally:
         sys.path[:] = saved_path
-        # a later load of the FMU must import its own copy: the staged one is deleted with
-        # the build folder, and a lazy import would then look for it there.  Modules of this
+        # the modules this build loaded name the staging folder (their __file__, the compiled
+        # kernel's path), deleted with the build folder: a later load of an FMU imports them
+        # again (from the zip read into memory, named in that FMU's folder).  Modules of this
         # runtime loaded before the build stay: they belong to FMUs this process runs now
-        # (an FMU loaded in-process imports its runtime from its own resources folder)
         for name in [m for m in sys.modules
                      if m == model_id or (m.split(".")[0] == runtime and m not in loaded)]:
             del sys.modules[name]
@@ -180,20 +222,19 @@ def bytecode(source, name):
 
 
 def rewrite_model_description(fmu, slave):
-    """Replace modelDescription.xml in the FMU zip (via a temporary copy) and add the
-    bytecode of every Python source in its resources (``bytecode``)."""
+    """Replace modelDescription.xml in the FMU zip (via a temporary copy) and drop the loose
+    copy of pythonfmu that pythonfmu's builder adds (the runtime zip holds it)."""
     tmp = Path(str(fmu) + ".tmp")
-    tag = sys.implementation.cache_tag
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for item in src.infolist():
+            if item.filename.startswith("resources/pythonfmu/"):
+                continue
             data = src.read(item)
-            name = item.filename
-            if name.startswith("resources/") and name.endswith(".py") and tag:
-                folder, _, module = name.rpartition("/")
-                dst.writestr(f"{folder}/__pycache__/{module[:-3]}.{tag}.pyc", bytecode(data, name))
             if item.filename == "modelDescription.xml":
                 data = model_description.complete(data, slave.units, slave.dependencies,
                                                   {v.name: slave._start[vr] for vr, v in slave.vars.items()})
+            if item.filename.endswith(".zip"):   # the runtime zip, stored inside: deflated here
+                item.compress_type = zipfile.ZIP_DEFLATED
             dst.writestr(item, data)
     tmp.replace(fmu)
 

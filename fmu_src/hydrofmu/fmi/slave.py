@@ -34,31 +34,23 @@ def _light_pythonfmu():
     """Let the slave import pythonfmu's slave API without pythonfmu's package __init__,
     which imports its FMU builder (argparse, zipfile, shutil, xml.dom…: ~25 ms of the
     ~35 ms import, paid by every host that starts an FMU).  Unless pythonfmu is loaded
-    already, the package module goes into sys.modules unexecuted, its __path__ set so that
-    its submodules import as usual; the first use of anything else (``pythonfmu.
-    FmuBuilder``…) runs the real __init__ in it (PEP 562 module __getattr__).  __path__
-    lists every copy on sys.path, the first found first: the FMU's own copy lives in its
-    extracted folder, which a host may delete after use (fmpy, hydrofmu's master)."""
-    import importlib.machinery
+    already, the package module goes into sys.modules unexecuted; its submodules import as
+    usual (in an FMU, from its runtime zip: fmi/runtime_zip.py, which also lists pythonfmu's
+    copies on disk in ``__path__`` for the modules the zip does not hold); the first use of
+    anything else (``pythonfmu.FmuBuilder``…) runs the real __init__ in it (PEP 562 module
+    __getattr__)."""
     import importlib.util
     if "pythonfmu" in sys.modules:
         return
     spec = importlib.util.find_spec("pythonfmu")
-    if spec is None or spec.loader is None or not spec.submodule_search_locations:
+    if spec is None or spec.loader is None or spec.submodule_search_locations is None:
         return
-    copies = [os.path.join(p, "pythonfmu") for p in sys.path if isinstance(p, str)]
-    copies = [p for p in copies if os.path.isfile(os.path.join(p, "__init__.py"))]
     pkg = importlib.util.module_from_spec(spec)
-    pkg.__path__ = list(dict.fromkeys(list(spec.submodule_search_locations) + copies))
 
     def rest(name):
         del pkg.__dict__["__getattr__"]
-        for folder in pkg.__path__:
-            init = os.path.join(folder, "__init__.py")
-            if os.path.isfile(init):
-                importlib.machinery.SourceFileLoader("pythonfmu", init).exec_module(pkg)
-                return getattr(pkg, name)
-        raise AttributeError(f"module 'pythonfmu' has no attribute {name!r} (no copy of pythonfmu left)")
+        spec.loader.exec_module(pkg)
+        return getattr(pkg, name)
 
     pkg.__getattr__ = rest
     sys.modules["pythonfmu"] = pkg
