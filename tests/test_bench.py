@@ -123,6 +123,17 @@ def test_floor_fmu_copies_its_inputs(tmp_path):
     assert names == ["u[1]", "u[2]", "u[3]", "u[4]", "y[1]", "y[2]"] and after == [1.0, 2.0]
 
 
+def test_fmpy_startup_rows_against_the_floor(tmp_path, demo_build):
+    """bench.startup.fmpy_compare: simulate_fmu of a scene's FMUs against as many floor FMUs,
+    one row per candidate: the median times and the median of the rounds' ratios."""
+    from hydrofmu.bench import floor, startup
+    rows = startup.fmpy_compare({"moored_barge": demo_build}, floor.build_floor(tmp_path), rounds=2, best=1)
+    [r] = rows
+    assert r["label"] == "moored_barge" and r["fmus"] == 2
+    assert r["simulate_s"] > 0 and r["simulate_floor_s"] > 0 and r["simulate_x"] > 0
+    assert r["simulate_noisy"] == (r["simulate_spread"] > floor.NOISY)
+
+
 def test_floor_spread_and_linearity_bookkeeping():
     from hydrofmu.bench import floor
     assert floor.spread([1.0, 1.2, 0.9]) == pytest.approx(0.3)

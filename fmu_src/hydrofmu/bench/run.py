@@ -416,6 +416,14 @@ def part_startup(out, quick):
     if design is not None and not design["startup_noisy"]:
         lines.append(f"target side_by_side ≤ 5× the floor in a running process: "
                      f"{'met' if design['startup_x'] <= 5 else 'NOT met'} ({design['startup_x']:.1f}×)")
+    fmpy_rows = startup.fmpy_compare({k: v for k, v in candidates.items() if not quick or k == "side_by_side"},
+                                     fmu, rounds=3 if quick else 10)
+    write_csv(out / "startup_fmpy.csv", fmpy_rows)
+    for r in fmpy_rows:
+        x = (f"too noisy ({over(r['simulate_spread'], floor.NOISY)}), no figure" if r["simulate_noisy"] else
+             f"{r['simulate_x']:.1f}× the floor ({1e3 * r['simulate_s']:.0f} vs {1e3 * r['simulate_floor_s']:.0f} ms)")
+        lines.append(f"{r['label']} ({r['fmus']} FMUs), fmpy simulate_fmu of one step each (unzip and delete "
+                     f"included) in a running process: {x}")
     return lines
 
 

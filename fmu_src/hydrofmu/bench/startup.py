@@ -1,5 +1,6 @@
 """Startup in a running process: what a master or a batch worker pays for each run after its
-first, against the pythonfmu floor.
+first, against the pythonfmu floor; and what fmpy's ``simulate_fmu`` pays, which unzips every
+FMU at each call and deletes it after (``fmpy_compare``).
 
 In one Python process, a scene's FMUs are loaded, instantiated and initialised
 (``cosim.master.load`` + ``initialize``) and freed again, ``rounds`` times (each figure the
@@ -59,3 +60,48 @@ def compare(candidates, floor_fmu, out, rounds=10, best=BEST, env=None):
                      "cycle_x": float(np.median(cx)), "cycle_spread": spread(cx), "cycle_noisy": spread(cx) > NOISY,
                      "first_s": got["first"][1][0], "first_floor_s": got["first"][0][0]})
     return rows
+
+
+FMPY_SCRIPT = '''import json, sys, time
+from fmpy import simulate_fmu
+fmus, rounds, best, step = json.loads(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
+def once(paths):
+    t0 = time.perf_counter()
+    for p in paths:
+        simulate_fmu(p, stop_time=step, step_size=step, output_interval=step)
+    return time.perf_counter() - t0
+def one_round():   # every candidate once, best times over, interleaved: a slow spell hits them alike
+    times = [{k: once(v) for k, v in fmus.items()} for _ in range(best)]
+    return {k: min(t[k] for t in times) for k in fmus}
+first = {k: once(v) for k, v in fmus.items()}
+print(json.dumps({"first": first, "rounds": [one_round() for _ in range(rounds)]}))
+'''
+
+
+def fmpy_compare(candidates, floor_fmu, rounds=10, best=BEST, step=0.05, env=None):
+    """Rows {label, fmus, simulate_s, simulate_floor_s, simulate_x, simulate_spread, simulate_noisy}
+    for each run folder (or list of FMUs) of ``candidates`` ({label: folder or [FMU]}): one
+    ``fmpy.simulate_fmu`` of one step per FMU (model description read and validated, FMU
+    unzipped, instantiated, initialised, stepped, freed and its folder deleted), against as
+    many of the floor FMU, all in one Python process after a first call of each; each figure
+    of a round the best of ``best``, medians over ``rounds``."""
+    fmus = {label: [str(p) for p in (c if isinstance(c, (list, tuple)) else _fmus_of(c))]
+            for label, c in candidates.items()}
+    floors = {f"floor{len(v)}": [str(floor_fmu)] * len(v) for v in fmus.values()}
+    run = subprocess.run([sys.executable, "-c", FMPY_SCRIPT, json.dumps({**floors, **fmus}), str(rounds), str(best),
+                          repr(step)], capture_output=True, text=True, check=True, timeout=900, env=env)
+    got = json.loads(run.stdout.strip().splitlines()[-1])["rounds"]
+    rows = []
+    for label, paths in fmus.items():
+        t = np.array([r[label] for r in got])
+        f = np.array([r[f"floor{len(paths)}"] for r in got])
+        x = t / f
+        rows.append({"label": label, "fmus": len(paths), "simulate_s": float(np.median(t)),
+                     "simulate_floor_s": float(np.median(f)), "simulate_x": float(np.median(x)),
+                     "simulate_spread": spread(x), "simulate_noisy": spread(x) > NOISY})
+    return rows
+
+
+def _fmus_of(folder):
+    manifest = json.loads((folder / "manifest.json").read_text())
+    return [folder / manifest["instances"][name]["fmu"] for name in manifest["order"]]
