@@ -3,13 +3,14 @@ several FMUs share a process safely — FMUs of different scenes, one FMU twice,
 same name from another hydrofmu version (another runtime hash), instances freed and their
 folders deleted while others run, instantiate-free-instantiate, and the runtime's modules
 dropped from sys.modules between instances (what a build in the process does to the modules
-it loaded) — in fmpy and in one libcosim execution, under PYTHONMALLOC=debug."""
+it loaded) — in fmpy and in one libcosim execution, under PYTHONMALLOC=debug, and in a C host."""
 import io
 import json
 import os
 import subprocess
 import sys
 import zipfile
+from pathlib import Path
 
 import pytest
 
@@ -18,6 +19,7 @@ from hydrofmu.fmi.build import build_scene
 from hydrofmu.scene import load_scene
 
 from conftest import MODELS
+from test_native import fmpy_reference, hosts, run_fmi_host, unzip  # noqa: F401 (hosts: a fixture)
 
 quiet = lambda *_: None  # noqa: E731
 
@@ -200,3 +202,22 @@ def test_several_fmus_in_one_fmpy_process(builds):
 def test_several_fmus_in_one_libcosim_execution(builds):
     pytest.importorskip("libcosimpy")
     in_debug_python(LIBCOSIM, builds)
+
+
+def test_two_runtimes_in_one_native_host(hosts, builds, tmp_path):
+    """The moored barge's load FMU and its build by 'another version' (another runtime, the
+    same model identifier) in one C host (no Python of its own: the shim starts it), four
+    instances at once from four threads, instance k on build k mod 2: each equals the FMU
+    stepped alone by fmpy with its inputs."""
+    now, other = unzip(builds["barge"], tmp_path / "now"), unzip(builds["other"], tmp_path / "other")
+    both = (Path(f"{now[0]},{other[0]}"),) + now[1:]
+    vr = now[3]
+    assert other[1:] != now[1:] and other[3] == vr   # another GUID, the same variables
+    inputs = {vr["position[1]"]: 2.0, vr["velocity[1]"]: 0.3, vr["velocity[6]"]: 0.01}
+    outputs = [vr[f"force[{i}]"] for i in (1, 2, 6)]
+    run, got = run_fmi_host(hosts, both, 4, 5, 0.1, inputs, outputs)
+    assert run.returncode == 0 and "host exits normally" in run.stdout, run.stdout[-2000:] + run.stderr
+    assert "LOG" not in run.stdout and "NULL" not in run.stdout, run.stdout[-2000:]
+    for k in range(4):
+        want = fmpy_reference(now, 5, 0.1, {v: x * (k + 1) for v, x in inputs.items()}, outputs)
+        assert {(n, o): got[k, n, o] for n, o in want} == want
