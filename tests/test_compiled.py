@@ -829,7 +829,8 @@ def test_random_wave_scene_compiled_equals_python(seed, tmp_path):
 
 def test_bad_sea_state_fails_initialization_naming_the_knob(wave_builds, tmp_path, capfd):
     """A waves.* value that is not a usable sea state: fmi2ExitInitializationMode is fmi2Error
-    with a log line naming the parameter, the Python flavour's line."""
+    with a log line naming the parameter, the Python flavour's line; a host that steps on
+    anyway gets fmi2Error from the step in either flavour, never loads without the waves."""
     from fmpy.fmi1 import FMICallException
     fmu = wave_builds["irregular"] / "waves_cyl1.fmu"
     unzipped = tmp_path / "u"
@@ -847,6 +848,9 @@ def test_bad_sea_state_fails_initialization_naming_the_knob(wave_builds, tmp_pat
         with pytest.raises(FMICallException):
             s.exitInitializationMode()
         assert message in capfd.readouterr().out
+        with pytest.raises(FMICallException):
+            s.doStep(0.0, 0.1)
+        assert "the waves.* parameters are not a usable sea state" in capfd.readouterr().out
         s.freeInstance()
         py, lines = python_slave(unzipped), []
         py.log = lambda text, *args, **kwargs: lines.append(text)
@@ -855,6 +859,10 @@ def test_bad_sea_state_fails_initialization_naming_the_knob(wave_builds, tmp_pat
         py.set_real([refs[knob]], [value])
         py.exit_initialization_mode()
         assert any(message in line for line in lines), lines
+        del lines[:]
+        assert py.do_step(0.0, 0.1) is False
+        assert any("the waves.* parameters are not a usable sea state" in line and message in line
+                   for line in lines), lines
 
 
 def test_nonfinite_output_fails_the_step_that_made_it(compiled, tmp_path, capfd):

@@ -298,8 +298,8 @@ class ArraySlave(Fmi2Slave):
 
     @guarded()
     def exit_initialization_mode(self):
+        self.running = True   # (before: an FMU whose physics cannot start fails its steps too, as in C)
         self.start_physics()
-        self.running = True
 
     def start_physics(self):
         pass
@@ -602,6 +602,12 @@ class LoadSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
+        if self.wave_cfg is not None and self.wave is None and self.running:
+            try:   # (initialization failed on the sea state: no step goes on without its waves)
+                self._start_waves()
+            except ValueError as exc:
+                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
+                return
         v = self.values
         ne = len(self.loads.effects)
         out = np.zeros((1 + ne + len(self.couplings) + (self.wave_cfg is not None), 6))   # total, effects, couplings, waves
