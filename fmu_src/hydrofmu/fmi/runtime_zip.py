@@ -33,7 +33,9 @@ PYTHONFMU = "pythonfmu"
 
 
 def read_zip(path):
-    """{member name: bytes} of the zip at ``path`` (stored or deflated members; each CRC checked)."""
+    """{member name: bytes} of the zip at ``path`` (stored or deflated members; each CRC checked).
+    Not ``zipfile``: it imports ``threading``, and a first import of ``threading`` on a host's
+    worker thread (libcosim steps FMUs on its own threads) hangs the interpreter at exit."""
     import binascii
     with open(path, "rb") as f:
         data = f.read()
