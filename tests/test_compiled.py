@@ -409,31 +409,35 @@ def test_state_serialize_and_reset_continue_exactly(compiled, wave_builds, tmp_p
             x.freeInstance()
 
 
-def test_guards_return_error_never_crash(compiled, tmp_path):
-    """Bad calls are fmi2Error with a log line: a parameter set after initialization, a value
-    reference out of range, a time jump, bytes that are not a state, a wrong GUID."""
+def guarded_slave(fmu, tmp, guid=None, lines=None):
+    """(slave, {name: value reference}, log lines [(status, message)]) of a compiled FMU
+    instantiated by fmpy (as ``guid``: default the FMU's) with a logger that keeps its lines
+    (appended to ``lines`` if given)."""
     from fmpy import calloc, free, read_model_description
-    from fmpy.fmi1 import FMICallException
     from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
     from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE
-    fmu = compiled["moored_barge"] / "moored_barge_barge.fmu"
-    unzipped = tmp_path / "u"
+    unzipped = Path(tmp) / "u"
     with zipfile.ZipFile(fmu) as z:
         z.extractall(unzipped)
     md = read_model_description(str(fmu))
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    lines = []
-
-    def logger(env, name, status, category, message):
-        lines.append((status, message.decode()))
-
+    lines = [] if lines is None else lines
     cb = fmi2CallbackFunctions()
-    cb.logger = fmi2CallbackLoggerTYPE(logger)
+    cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: lines.append((status, msg.decode())))
     cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    s = FMU2Slave(guid=md.guid, unzipDirectory=str(unzipped), modelIdentifier=md.coSimulation.modelIdentifier,
+    s = FMU2Slave(guid=guid or md.guid, unzipDirectory=str(unzipped), modelIdentifier=md.coSimulation.modelIdentifier,
                   instanceName="g")
     s.instantiate(callbacks=cb)
+    s._keep = cb   # (the callbacks must outlive the instance)
+    return s, {v.name: v.valueReference for v in md.modelVariables}, lines
+
+
+def test_guards_return_error_never_crash(compiled, tmp_path):
+    """Bad calls are fmi2Error with a log line: a parameter set after initialization, a value
+    reference out of range, a time jump, bytes that are not a state, a wrong GUID."""
+    from fmpy.fmi1 import FMICallException
+    fmu = compiled["moored_barge"] / "moored_barge_barge.fmu"
+    s, refs, lines = guarded_slave(fmu, tmp_path)
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
     s.exitInitializationMode()
@@ -448,33 +452,9 @@ def test_guards_return_error_never_crash(compiled, tmp_path):
     s.doStep(0.0, 0.1)   # still usable
     s.terminate()
     s.freeInstance()
-    wrong = FMU2Slave(guid="not-the-guid", unzipDirectory=str(unzipped),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="w")
     with pytest.raises(Exception, match="Failed to instantiate"):
-        wrong.instantiate(callbacks=cb)
+        guarded_slave(fmu, tmp_path / "w", guid="not-the-guid", lines=lines)
     assert "does not match this FMU's" in lines[-1][1]
-
-
-def guarded_slave(fmu, tmp):
-    """(slave, {name: value reference}, log lines [(status, message)]) of a compiled FMU
-    instantiated by fmpy with a logger that keeps its lines."""
-    from fmpy import calloc, free, read_model_description
-    from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-    from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE
-    unzipped = Path(tmp) / "u"
-    with zipfile.ZipFile(fmu) as z:
-        z.extractall(unzipped)
-    md = read_model_description(str(fmu))
-    lines = []
-    cb = fmi2CallbackFunctions()
-    cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: lines.append((status, msg.decode())))
-    cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-    cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    s = FMU2Slave(guid=md.guid, unzipDirectory=str(unzipped), modelIdentifier=md.coSimulation.modelIdentifier,
-                  instanceName="g")
-    s.instantiate(callbacks=cb)
-    s._keep = cb   # (the callbacks must outlive the instance)
-    return s, {v.name: v.valueReference for v in md.modelVariables}, lines
 
 
 def test_fast_paths_keep_every_guard(compiled, tmp_path):

@@ -115,23 +115,28 @@ body = "BARGE"
 
 
 def target_scene(folder) -> Path:
-    """The FMU the target names and nothing else: one barge of models/side_by_side.toml with its
-    own SIMO radiation memory (state space, the design preset) and AQWA viscous drag in current."""
-    decks = (Path(__file__).resolve().parents[3] / "models" / "decks").as_posix()
+    """The FMU the target names and nothing else: barge_a of models/side_by_side.toml (its mass,
+    inertia, stiffness and current) with its own SIMO radiation memory (state space, the design
+    preset) and AQWA viscous drag."""
+    from ..textfile import read_toml
+    models = Path(__file__).resolve().parents[3] / "models"
+    scene = read_toml(models / "side_by_side.toml")
+    barge, env = scene["bodies"]["barge_a"], scene["environment"]
+    decks = (models / "decks").as_posix()
     path = Path(folder) / "drag_memory.toml"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(f"""[scene]
 name = "drag_memory"
 [environment]
-current_speed = 0.5
-current_direction = 90.0
+current_speed = {env["current_speed"]!r}
+current_direction = {env["current_direction"]!r}
 [run]
 preset = "design"
 stop = 10.0
 [bodies.barge]
-mass = 1.28125e7
-inertia = [7.74e8, 1.078e10, 1.134e10]
-stiffness = [2.0e5, 2.0e5, 2.513e7, 9.9e8, 2.06e10, 5.0e8]
+mass = {barge["mass"]!r}
+inertia = {barge["inertia"]!r}
+stiffness = {barge["stiffness"]!r}
 [[bodies.barge.effects]]
 type = "aqwa_viscous_drag"
 deck = "{decks}/barge_viscous.aqwa"
@@ -166,8 +171,9 @@ def part(out, quick, pythonfmu_floor):
     joined = build_scene(load_scene(Path(__file__).resolve().parents[3] / "models" / "joined_barges.toml"),
                          out / "scenes", log=quiet, runtime="c")
     load = drag / "side_by_side_barge_a.fmu"
-    ports = native.unpack(target, out / "ports")
-    n_in, n_out = ports[3].count(":"), len(ports[4].split(","))
+    from fmpy import read_model_description
+    causality = [v.causality for v in read_model_description(str(target)).modelVariables]
+    n_in, n_out = causality.count("input"), causality.count("output")
     candidates = {
         "load FMU, state-space memory + drag, inputs changing every step": (target, True),
         "the same FMU as coupled (motion in, total load out), inputs changing every step": (target, True, COUPLED),

@@ -101,10 +101,7 @@ static void ss_prepare(HfStateSpace *ss, double dt) {
 static void ss_step(HfStateSpace *ss, double dt, const double *v) {
     ss_prepare(ss, dt);
     double *f = ss->pforce;
-    if (ss->m)
-        for (int i = 0; i < 6; i++) f[i] = 0.0;
-    else
-        memcpy(f, ss->force, sizeof ss->force);
+    for (int i = 0; i < 6; i++) f[i] = 0.0;
     for (int k = 0; k < ss->m; k++) {
         const double *c = ss->coef + COEF * k;
         double vn = v[ss->io[2 * k]];
@@ -129,10 +126,7 @@ void hf_ss_peek(HfStateSpace *ss, double dt, const double *v, double *force) {
 void hf_ss_advance(HfStateSpace *ss, double dt, const double *v) {
     ss_prepare(ss, dt);
     double *now = ss->force, *next = ss->pforce;
-    if (ss->m)
-        for (int i = 0; i < 6; i++) now[i] = next[i] = 0.0;
-    else
-        memcpy(next, now, sizeof ss->pforce);
+    for (int i = 0; i < 6; i++) now[i] = next[i] = 0.0;
     for (int k = 0; k < ss->m; k++) {
         const double *c = ss->coef + COEF * k;
         double vn = v[ss->io[2 * k]];

@@ -174,12 +174,12 @@ class Convolution:
         return -np.bincount(self._out, weights=f, minlength=self.shape[0]), lo
 
     def _weights_of(self, s, steps):
-        """The node weights of offsets s, made of the step lengths ``steps`` (newest first).
+        """The node weights of offsets s, made of the step lengths ``steps`` (newest first,
+        one per node after the first).
         While the history fills at a constant step, s is the start of one uniform grid and
         only its last node's hat is cut short: the weights are the grid's, each node's two
         half-hats computed once for the whole grid (a rebuild at every step would cost ten
         times the weighted sum, for the first memory length)."""
-        steps = steps[:s.size - 1]   # (those of the nodes kept)
         if steps.size and steps[0] > 0 and (steps == steps[0]).all():
             dt = float(steps[0])
             if self._grid is None or self._grid[0] != dt:
