@@ -471,12 +471,6 @@ def numeric_rows(path, names, counts=None):
         if not rows and not _STARTS_NUMBER.match(words[0]) and not all(map(_is_fortran_number, words)):
             header.append((number, text.strip()))
             continue
-        if len(words) not in counts:
-            many = len(words) > max(counts)
-            want = " or ".join(map(str, counts))
-            raise InputError(path, number, " ".join(names) if many else names[len(words)],
-                             f"expected {want} numbers ({' '.join(names)}), found {len(words)}: {text.strip()!r}"
-                             + (": more fields than the format (a merged or shifted line?)" if many else ""))
         values = []
         for name, word in zip(names, words):
             try:
@@ -487,5 +481,11 @@ def numeric_rows(path, names, counts=None):
             if not math.isfinite(value):
                 raise InputError(path, number, name, f"non-finite value {word!r}")
             values.append(value)
+        if len(words) not in counts:
+            many = len(words) > max(counts)
+            want = " or ".join(map(str, counts))
+            raise InputError(path, number, " ".join(names) if many else names[len(words)],
+                             f"expected {want} numbers ({' '.join(names)}), found {len(words)}: {text.strip()!r}"
+                             + (": more fields than the format (a merged or shifted line?)" if many else ""))
         rows.append((number, values))
     return rows, header
