@@ -213,3 +213,69 @@ def test_wavenumber_conversion_is_the_deep_water_dispersion():
     assert wamit_omega("f", 1, 0.8, "wavenumber", ulen=2.0, g=9.81) == pytest.approx(math.sqrt(0.8 * 9.81 / 2.0))
     assert wamit_omega("f", 1, 0.5, "hz") == pytest.approx(math.pi)
     assert wamit_omega("f", 1, -1.0, "period") == 0.0 and wamit_omega("f", 1, 0.0, "period") == math.inf
+
+
+# --- every row edited: read as written, refused at its line, or said ----------------------
+
+def _small_files(tmp_path):
+    """Small WAMIT files with a header: a .1 (one body, dofs 1 and 3, PER = 0 and three
+    periods), a .3 (two periods, two headings, six dofs) and a .hst (36 pairs)."""
+    rng = np.random.default_rng(3)
+    head = HEADER.format(name="s")
+    one = [head] + [f"0.0 {i} {j} {rng.uniform(1, 2):.6E}" for i in (1, 3) for j in (1, 3)]
+    one += [f"{per} {i} {j} {rng.uniform(1, 2):.6E} {rng.uniform(0.1, 1):.6E}"
+            for per in (12.0, 8.0, 5.0) for i in (1, 3) for j in (1, 3)]
+    three = [head] + [f"{per} {beta} {i} 1.0 0.0 {rng.normal():.6E} {rng.normal():.6E}"
+                      for per in (10.0, 6.0) for beta in (0.0, 90.0) for i in range(1, 7)]
+    hst = [head] + [f"{i} {j} {rng.normal():.6E}" for i in range(1, 7) for j in range(1, 7)]
+    out = {}
+    for suffix, lines in ((".1", one), (".3", three), (".hst", hst)):
+        out[suffix] = (tmp_path / f"s{suffix}", lines)
+    return out
+
+
+def _read(path):
+    return {".1": lambda p: read_wamit(p, ULEN, RHO), ".3": lambda p: read_excitation(p, ulen=ULEN, rho=RHO, g=G),
+            ".hst": lambda p: read_hydrostatics(p, ulen=ULEN, rho=RHO, g=G)}[path.suffix](path)
+
+
+def _values(data):
+    if hasattr(data, "added_mass"):
+        return np.concatenate([data.added_mass.ravel(), data.damping.ravel(), data.a_inf.ravel()])
+    if hasattr(data, "values"):
+        return data.values.ravel()
+    return np.concatenate([m.ravel() for m in data.stiffness.values()])
+
+
+@pytest.mark.parametrize("suffix", [".1", ".3", ".hst"])
+def test_every_row_edit_is_read_as_written_or_refused_or_said(tmp_path, suffix):
+    """The deck mutation suite's edits on WAMIT rows: a number appended (a row with more
+    fields than its format), a row dropped, a row doubled, two rows swapped, the header
+    dropped.  Appended and doubled rows are refused at their line; a dropped row is refused
+    (a gap at one period) or, in a .hst, said; swaps and the header change nothing."""
+    path, lines = _small_files(tmp_path)[suffix]
+    path.write_text("\n".join(lines) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)
+        base = _values(_read(path))
+    for k in range(1, len(lines)):
+        edits = {"append": lines[:k] + [lines[k] + " 0.25"] + lines[k + 1:],
+                 "double": lines[:k + 1] + lines[k:],
+                 "drop": lines[:k] + lines[k + 1:]}
+        for kind, text in edits.items():
+            path.write_text("\n".join(text) + "\n")
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always", InputWarning)
+                try:
+                    _read(path)
+                except InputError as err:
+                    assert err.path == str(path) and err.line is not None, (kind, k, err)
+                    if kind == "append":
+                        assert err.line == k + 1 and ("more fields than the format" in err.message
+                                                      or "WAMIT writes Ā alone at the limits" in err.message)
+                    continue
+            assert kind == "drop" and suffix == ".hst" and len(said) == 1, (kind, k, "read without a word")
+            assert f"({(k - 1) // 6 + 1}, {(k - 1) % 6 + 1})" in str(said[0].message)
+    for text in (lines[1:], lines[:1] + lines[2:3] + lines[1:2] + lines[3:]):   # no header; two rows swapped
+        path.write_text("\n".join(text) + "\n")
+        np.testing.assert_array_equal(_values(_read(path)), base)

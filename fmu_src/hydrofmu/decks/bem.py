@@ -330,6 +330,9 @@ def read_wamit(path, ulen, rho, g=None, variable=None):
         i, j = (_dof_index(path, number, v, name) for v, name in ((vals[1], "I"), (vals[2], "J")))
         if np.isfinite(w) and w > 0 and len(vals) != 5:
             raise InputError(path, number, "B", f"missing the damping at {_as_written(vals[0], variable)}")
+        if not (np.isfinite(w) and w > 0) and len(vals) == 5 and vals[4] != 0:
+            raise InputError(path, number, "B", f"a damping {vals[4]:g} at PER = {vals[0]:g}: WAMIT writes Ā alone "
+                                                "at the limits (B = 0 there); a fifth number is a shifted row?")
         key = (w, i, j)
         if key in first:
             raise InputError(path, number, "I J", f"duplicate ({_as_written(vals[0], variable)}, I = {i}, J = {j}) "

@@ -31,7 +31,8 @@ default; ``omega``, ``wavenumber``, ``hz``); the PER = −1 / 0 rows (no inciden
 not excitation and are passed over.  Every period must list the same headings and every
 (period, heading) the same dofs (a gap is an error at its line: it would read as zeros);
 dofs of a body with no row at all (WAMIT leaves out modes it did not compute) read as zero
-and are said once (a warning naming them, kept in ``reading``).
+and are said once (a warning naming them, kept in ``reading``).  A ``.hst`` pair given twice
+is an error; pairs of a body without a row read as zero and are said (WAMIT writes all 36).
 """
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -88,6 +89,7 @@ class HydrostaticsData:
     rotation_centers: dict = field(default_factory=dict)
     rho: float = None
     g: float = None
+    reading: object = None    # decks.lines.Reading: the warnings of a WAMIT file
 
 
 def _open(path):
@@ -334,9 +336,12 @@ def _capytaine_hydrostatics(path):
 def _wamit_hydrostatics(path, ulen, rho, g):
     _wamit_scale(path, ulen, rho, g)
     rows, _ = numeric_rows(path, ["I", "J", "C"])
-    stiffness = {}
+    stiffness, first = {}, {}
     for number, (i, j, c) in rows:
         i, j = _index(path, number, i), _index(path, number, j, "J")
+        if (i, j) in first:
+            raise InputError(path, number, "I J", f"duplicate ({i}, {j}) (first at line {first[(i, j)]})")
+        first[(i, j)] = number
         bi, bj = (i - 1) // 6 + 1, (j - 1) // 6 + 1
         if bi != bj:
             if c != 0:
@@ -347,4 +352,12 @@ def _wamit_hydrostatics(path, ulen, rho, g):
         m[ki, kj] = c * rho * g * ulen ** (2 + (ki >= 3) + (kj >= 3))
     if not stiffness:
         raise InputError(path, None, "I J C", "no hydrostatic coefficients in the file")
-    return HydrostaticsData(str(path), "WAMIT", stiffness, sorted(stiffness), weight=True)
+    reading = Reading(str(path), "WAMIT .hst")
+    for b in sorted(stiffness):
+        base = 6 * (int(b[4:]) - 1)
+        absent = [(base + i, base + j) for i in range(1, 7) for j in range(1, 7) if (base + i, base + j) not in first]
+        if absent:
+            shown = ", ".join(f"({i}, {j})" for i, j in absent[:6]) + (", …" if len(absent) > 6 else "")
+            reading.warn(None, "I J", f"{len(absent)} of the 36 pairs of {b} have no row, read as zero: {shown} "
+                                      "(WAMIT writes every pair of a body; a cut file drops some)")
+    return HydrostaticsData(str(path), "WAMIT", stiffness, sorted(stiffness), weight=True, reading=reading)
