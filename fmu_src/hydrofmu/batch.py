@@ -155,7 +155,7 @@ def _one_kind(p, where, key, values):
     kinds = [_kind(v) for v in values]
     odd = next((k for k, kind in enumerate(kinds) if kind != kinds[0]), None)
     if odd is not None:
-        p.add(where, f"value {values[odd]!r} is {kinds[odd]} among {kinds[0]}s ({values[0]!r}, …): every case's "
+        p.add(where, f"value {values[odd]!r} is {kinds[odd]} among {kinds[0].split()[1]}s ({values[0]!r}, …): every case's "
                      "value of a knob is one kind (the table's column)")
 
 
