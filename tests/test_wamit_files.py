@@ -279,3 +279,21 @@ def test_every_row_edit_is_read_as_written_or_refused_or_said(tmp_path, suffix):
     for text in (lines[1:], lines[:1] + lines[2:3] + lines[1:2] + lines[3:]):   # no header; two rows swapped
         path.write_text("\n".join(text) + "\n")
         np.testing.assert_array_equal(_values(_read(path)), base)
+
+
+def test_bem2simo_reads_a_wamit_one_in_omega(tmp_path, capsys):
+    """`bem2simo --period-variable omega` on a .1 whose first column is ω: the SIMO deck of the
+    period form, written the same."""
+    from hydrofmu import cli
+    periods = write_one(tmp_path / "p.1", limits=False)
+    omegas = write_one(tmp_path / "w.1", "omega", limits=False)
+    assert cli.main(["bem2simo", str(periods), "-o", str(tmp_path / "p.sim"), "--ulen", "2"]) == 0
+    assert cli.main(["bem2simo", str(omegas), "-o", str(tmp_path / "w.sim"), "--ulen", "2",
+                     "--period-variable", "omega"]) == 0
+    def numbers(path):
+        words = [w for line in path.read_text().splitlines() if not line.startswith("'") for w in line.split()]
+        return [float(w) for w in words if w[0].isdigit() or w[0] in "+-."]
+    p, w = numbers(tmp_path / "p.sim"), numbers(tmp_path / "w.sim")
+    assert len(p) == len(w) > 1000        # 9 digits written: ω from the period differs in the 9th
+    np.testing.assert_allclose(w, p, rtol=1e-6, atol=1e-6 * np.max(np.abs(p)))
+    capsys.readouterr()
