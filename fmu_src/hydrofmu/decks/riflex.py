@@ -27,7 +27,10 @@ group without its IRX line; any other line left after one of our groups is an er
 level beyond NCULEV, a fourth CONB line).  A line that resembles one of our keywords
 (``UNIT NA SPEC``, ``NEW COMP BOD``, words after it) is an error, as is a second ``UNIT NAMe
 SPECification`` and a group right after a CONB whose first line reads as the CONB's IRX IRY
-IRZ line (a stray or misplaced line inside the CONB group).
+IRZ line (a stray or misplaced line inside the CONB group).  The codes are numbers (the
+manual's 0 and 1): a line of one to three freedom words after a CONB (``FIX FIX FREE``,
+``fixed``; ``CODE_WORDS``) is the IRX IRY IRZ line written in words, an error at its line and
+field, never a skipped group (it left the hinge a ball joint).
 """
 from dataclasses import dataclass, replace
 
