@@ -478,3 +478,10 @@ def test_run_rows_beyond_memory_are_refused_before_the_run(demo_build, monkeypat
     with pytest.raises(InputError) as err:
         run(demo_build, stop=1.0)
     assert err.value.field == "run.stop" and "output values would need" in err.value.message
+
+
+def test_components_beyond_the_compiled_limit_are_refused(tmp_path):
+    """More components than physics/waves.c takes (1e7) is the scene's error for both flavours."""
+    with pytest.raises(InputError) as err:
+        load_scene(wave_scene(tmp_path, 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 20000000'))
+    assert "waves.components: 2e+07 wave components: more than 1e+07" in str(err.value)

@@ -53,6 +53,7 @@ def read_waves(problems, table):
 # bytes a wave component holds in a load FMU: ω, a, β, φ and k, and the transfer function's
 # six complex values per body at it (a generous bound for a few bodies)
 COMPONENT_BYTES = 8 * 5 + 16 * 6 * 4
+MAX_COMPONENTS = 10 ** 7   # physics/waves.c refuses more at initialization: said here, for both flavours
 
 
 def _plausible(problems, table, spectrum, values):
@@ -61,6 +62,9 @@ def _plausible(problems, table, spectrum, values):
     memory (an error before anything is allocated).  False after recording an error."""
     errors, warns = sea_problems(spectrum, values, getattr(problems, "env", {}).get("g", 9.81))
     too_big = size_problem(values["components"], COMPONENT_BYTES, "wave components")
+    if values["components"] > MAX_COMPONENTS and not too_big:
+        too_big = (f"{values['components']:.4g} wave components: more than {MAX_COMPONENTS:.0e}, the compiled "
+                   "FMUs' limit (each step sums them all)")
     if too_big and spectrum != "regular":
         errors.append(("components", too_big))
     for key, message in errors:
