@@ -279,6 +279,7 @@ def check_knobs(batch):
         _check_transient(batch, run)
     else:
         doc = read_toml(batch.scene, "scene")
+        _check_sea_knobs(batch, doc)
         first = {k: v for k, v in _first_values(batch).items()
                  if k.split(".", 1)[0].split("[", 1)[0] in SCENE_SECTIONS and k not in EXPOSED}
         for key, value in first.items():
@@ -299,6 +300,32 @@ def check_knobs(batch):
                 return None   # the scene's own error is every case's
         _check_transient(batch, run)
     _check_case_steps(batch, run)
+
+
+def _check_sea_knobs(batch, doc):
+    """Every value of a ``waves.*`` knob (FMU parameters: the scene's checks never see them)
+    against what a sea can be and the memory (admissible.sea_problems, the scene's component
+    limit), the scene's other [waves] values kept: one InputError naming the knob and value."""
+    from .admissible import sea_problems, size_problem
+    from .scene.waves import COMPONENT_BYTES, MAX_COMPONENTS
+    waves = doc.get("waves")
+    if not isinstance(waves, dict):
+        return
+    spectrum = waves.get("spectrum", "jonswap")
+    for key in batch.keys:
+        if not key.startswith("waves."):
+            continue
+        name = key.split(".", 1)[1]
+        values = list(batch.matrix.get(key, [])) + [c[key] for c in [batch.fixed, *batch.extra] if key in c]
+        for value in values:
+            if _kind(value) != "a number":
+                continue
+            errors = [m for k, m in sea_problems(spectrum, {**waves, name: value})[0] if k == name]
+            if name == "components" and spectrum != "regular":
+                big = size_problem(value, COMPONENT_BYTES, "wave components")
+                errors += [big] if big else [f"more than {MAX_COMPONENTS:.0e}"] if value > MAX_COMPONENTS else []
+            if errors:
+                raise InputError(batch.path, None, key, f"value {value!r}: {errors[0]}")
 
 
 def _check_transient(batch, run):
