@@ -123,12 +123,33 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         parquet = Path(csv).with_suffix(".parquet")
     check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
+    from .cosim.master import RunError
     try:
         result = run(folder, sink=Sink(parquet, csv) if parquet or csv else None, **kw)
     except InputError as exc:   # the run's own --outputs/--interval, named as the command line says them
         raise _as_option(exc) from None
+    except RunError as exc:   # a run that failed keeps what it computed: its files, and the plot of them
+        _plot_partial(exc, manifest, png, log)
+        raise
     result.written = {Path(asked): Path(got) for asked, got in getattr(result, "written", {}).items()}
     return _plot_and_summary(result, png, summary, transient, log)
+
+
+def _plot_partial(exc, manifest, png, log):
+    """The plot of a failed run's rows up to the failure (kept by the master), said in its message."""
+    written = list(getattr(exc, "written", {}).values())
+    if not png or not written:
+        return
+    try:
+        from .cosim.result import read_csv
+        from .cosim.stream import read_parquet
+        got = written[-1]
+        partial = read_parquet(got) if str(got).endswith(".parquet") else read_csv(got, manifest)
+        if _unplotted(partial) is None and len(partial.time) > 1:
+            drawn = keep(partial.plot, png, log)[0]
+            exc.args = (exc.args[0] + f", the plot of them in {drawn}",)
+    except Exception as why:   # the failure's own message matters more than the plot's
+        log(f"warning: no plot of the failed run's rows ({type(why).__name__}: {why})")
 
 
 def _as_option(exc):
