@@ -284,6 +284,7 @@ def tune(args):
     check_outputs(files=(args.scene,) if args.write else (), plots=(png,),
                   inputs=(*scene_files(args.scene), *(() if args.write else (args.scene,))))
     found = run_tune(args.scene, tolerance(args.tolerance), outputs=args.outputs, window=args.window,
+                     confirm=args.confirm,
                      repeats=args.repeats, png=png, log=lambda s: None)
     for line in found.report():
         print(line)
@@ -405,8 +406,11 @@ def make_parser():
     t.add_argument("--outputs", nargs="+", metavar="NAME",
                    help="what the error is measured on: body names, body.position (attitude, velocity, "
                         "acceleration) or instance.variable columns (default: every body's position and attitude)")
-    t.add_argument("--window", type=float, metavar="T", help="simulated time of each run [s] (default: the "
-                                                            "scene's stop, at most 60 s)")
+    t.add_argument("--window", type=float, metavar="T", help="simulated time of each search run [s] (default: "
+                                                            "the scene's stop, at most 60 s)")
+    t.add_argument("--confirm", type=float, metavar="T", help="length of the runs that confirm the choice [s], "
+                                                             "a whole number of windows (default: the scene's stop; "
+                                                             "shorter: the error's drift is extrapolated to it)")
     t.add_argument("--repeats", type=int, default=3, help="interleaved timing rounds of the final candidates")
     t.add_argument("--png", type=Path, metavar="FILE", help="plot of the points run (default: build/tune/<scene>.png)")
     t.add_argument("--write", action="store_true", help="write the choice into the scene's [run] table (the rest "
