@@ -410,7 +410,7 @@ def make_parser():
                                                             "the scene's stop, at most 60 s)")
     t.add_argument("--confirm", type=float, metavar="T", help="length of the runs that confirm the choice [s], "
                                                              "a whole number of windows (default: the scene's stop; "
-                                                             "shorter: the error's drift is extrapolated to it)")
+                                                             "shorter: the error's drift is checked)")
     t.add_argument("--repeats", type=int, default=3, help="interleaved timing rounds of the final candidates")
     t.add_argument("--png", type=Path, metavar="FILE", help="plot of the points run (default: build/tune/<scene>.png)")
     t.add_argument("--write", action="store_true", help="write the choice into the scene's [run] table (the rest "

@@ -28,8 +28,8 @@
    re-timed in ``repeats`` interleaved rounds: cost = median seconds of stepping per
    simulated second (initialisation excluded), spread = (max − min) / median.
 4. The choice confirmed over the run it is tuned for (``confirm``): the candidates, cheapest
-   first, run over the scene's ``stop`` (or ``confirm`` seconds, the error's drift
-   extrapolated to the stop) against the reference over the same length; the first that
+   first, run over the scene's ``stop`` (or ``confirm`` seconds, with the drift check of
+   ``confirm.py``: the last quarter's error meets the tolerance and has not grown 2x) against the reference over the same length; the first that
    meets the tolerance there is the choice, one that does not is reported, not offered.
 
 Modules, by step: ``settings`` (the knobs searched, ``Setting``, ``Point``), ``runner`` (runs in
@@ -92,7 +92,7 @@ def tune(scene: str | Path, tolerance: float = 0.005, *, outputs: Sequence[str] 
         Simulated time of each search run [s]; default: the scene's stop, at most 60 s.
     confirm : float, optional
         Length of the confirmation runs [s], a whole number of windows, at most the scene's
-        stop; default: the scene's stop (shorter: the error's drift is extrapolated to it).
+        stop; default: the scene's stop (shorter: the error's drift is checked, ``confirm.py``).
     repeats : int
         Interleaved timing rounds of the final candidates (cost = median).
     png : str or Path, optional
