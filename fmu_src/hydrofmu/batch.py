@@ -43,6 +43,7 @@ import numpy as np
 from .errors import InputError, InputWarning
 from . import keys as file_keys
 from .names import did_you_mean, unknown
+from .physics.rigid_body import LINEAR_RANGE
 from .cosim.manifest import read_manifest
 from .textfile import read_toml
 from .writable import check_folder
@@ -544,22 +545,52 @@ def statistics(time_, values, outputs, transient=0.0):
     return out
 
 
+# the cases' linear_range column: false past the dynamics partner's linear range (15°)
+LINEAR_RANGE_DEG = math.degrees(LINEAR_RANGE)
+
+
+def _tilt_columns(folder):
+    """The roll and pitch columns of every body of a built scene (its manifest's dynamics)."""
+    from .cosim.manifest import read_manifest
+    return [f"{inst}.{prefix}attitude[{k}]" for inst, prefix in read_manifest(folder)["dynamics"].values()
+            for k in (1, 2)]
+
+
+def _max_tilt(columns, values, tilt):
+    """The largest |roll| or |pitch| [deg] over the run, of the ``tilt`` columns recorded."""
+    cols = [columns.index(c) for c in tilt if c in columns]
+    return float(np.degrees(np.nanmax(np.abs(values[:, cols])))) if cols and len(values) else 0.0
+
+
 def run_case(task, blob):
     """Run one case on a worker; never raises for a failing case (status 'failed', error)."""
     from .cosim.master import run
     with _LOCK:
         t0 = time.perf_counter()
-        out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None}
+        out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None,
+               "linear_range": None, "max_tilt_deg": None}
+        tilt = []
         try:
             folder = _materialize(blob)
+            tilt = _tilt_columns(folder)
+            record = list(task["outputs"]) + [c for c in tilt if c not in task["outputs"]]
             t0 = time.perf_counter()
-            result = run(folder, record=task["outputs"], parameters=task["parameters"], progress=False,
-                         **task["run"])
+            result = run(folder, record=record, parameters=task["parameters"], progress=False, **task["run"])
         except Exception as exc:   # a failing case is reported, the batch goes on
-            out.update(status="failed", error=f"{type(exc).__name__}: {exc}", wall_s=time.perf_counter() - t0)
+            text = str(exc)
+            # capsized (the dynamics partner's word): said first, not as an exception's class
+            error = f"capsized{text.split('capsized', 1)[1]} ({text.split(':', 1)[0]})" if "capsized:" in text \
+                else f"{type(exc).__name__}: {text}"
+            out.update(status="failed", error=error, wall_s=time.perf_counter() - t0)
+            partial = getattr(exc, "partial", None)
+            if "capsized:" in text:
+                out.update(linear_range=False, max_tilt_deg=90.0 if partial is None else
+                           max(90.0, _max_tilt(partial.columns, partial.values, tilt)))
             return out
         out["wall_s"] = time.perf_counter() - t0
-        values = result.values
+        worst = _max_tilt(record, result.values, tilt)
+        out.update(max_tilt_deg=worst, linear_range=bool(worst <= LINEAR_RANGE_DEG))
+        values = result.values[:, :len(task["outputs"])]
         bad = ~np.isfinite(values)
         if bad.any():
             k, j = np.argwhere(bad)[0]
@@ -734,6 +765,7 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
     def record(cid, knobs, variant, result):
         row = {"case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
                "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
+               "linear_range": result.get("linear_range"), "max_tilt_deg": result.get("max_tilt_deg"),
                "worker": result.get("worker")}
         try:
             (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
@@ -837,9 +869,10 @@ def assemble_table(out, ids, batch, units=None, kept=None, log=print):
     for cid in ids:
         r = (kept or {}).get(cid) or json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
         rows.append({**{k: _cell(v) for k, v in r["knobs"].items()}, "status": r["status"], "wall_s": r["wall_s"],
+                     "linear_range": r.get("linear_range"), "max_tilt_deg": r.get("max_tilt_deg"),
                      **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
     stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
-    columns = batch.keys + ["status", "wall_s"] + stats + ["error", "case", "build"]
+    columns = batch.keys + ["status", "wall_s", "linear_range", "max_tilt_deg"] + stats + ["error", "case", "build"]
     table = pd.DataFrame(rows, columns=columns)
     written = {}
     for name, write in (("cases.csv", lambda p: table.to_csv(p, index=False)),

@@ -150,7 +150,7 @@ WAVES = {
     "spreading": (NONNEG, "cos-2s spreading exponent s (0: long-crested)"),
     "components": ({"type": "integer", "minimum": 1}, "number of wave components (default 200)"),
     "seed": ({"type": "integer", "minimum": 0}, "random seed of frequencies, phases, directions"),
-    "ramp": (NONNEG, "length of the smooth start ramp [s]"),
+    "ramp": (NONNEG, "length of the smooth start ramp [s] (default: 3 peak periods; 0: none)"),
     "depth": (POSITIVE, "water depth [m] (default: deep water)"),
 }
 

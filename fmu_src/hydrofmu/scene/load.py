@@ -12,7 +12,7 @@ from .couplings import read_couplings
 from .current import read_current
 from .joints import read_joint
 from .problems import Problems, identifier
-from .run import read_run
+from .run import read_run, stable_defaults
 from .waves import check_wave_effects, read_waves
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")
@@ -105,6 +105,9 @@ def _load_scene(path, overrides=None):
     speed, direction, profile = read_current(p, env)
     check_wave_effects(p, bodies, sea, rho, g)
     _check_names(p, bodies, joints, couplings)
+    if None not in (run_cfg["step"], run_cfg["stop"]):
+        stable_defaults(run_cfg, bodies, couplings, sea,
+                        isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"])
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,

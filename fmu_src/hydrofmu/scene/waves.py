@@ -10,6 +10,9 @@ from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_
 from .couplings import CENTRE_TOL
 
 WAVE_KEYS = keys.names(keys.WAVES)
+# the ramp a sea state gets unless [waves] sets one: this many peak periods (a start without
+# a ramp kicks a body that has no surge stiffness into a drift of hundreds of metres, docs/tuning.md)
+RAMP_PERIODS = 3.0
 
 
 def read_waves(problems, table):
@@ -41,6 +44,8 @@ def read_waves(problems, table):
         return None
     for key in ("components", "seed"):
         values[key] = int(values[key]) if values[key] == int(values[key]) else values[key]
+    if "ramp" not in table:
+        values["ramp"] = RAMP_PERIODS * (values["period"] if spectrum == "regular" else values["tp"])
     sea = SeaState(spectrum, **values)
     try:
         sea.check()
