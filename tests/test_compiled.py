@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import MODELS, build
+from conftest import MODELS, build, tools
 
 SCENES = sorted(p.stem for p in MODELS.glob("*.toml"))
 SIMO = MODELS / "decks" / "side_by_side.sim"
@@ -538,8 +538,8 @@ def test_win64_binary_exports_every_fmi2_function(compiled):
     """The mingw-w64 cross-compiled win64 DLL (not run here: no Windows host in the tests)
     is an x86-64 PE library exporting the FMI 2.0 co-simulation functions and needing no
     runtime DLL beyond Windows' own."""
-    objdump = shutil.which("x86_64-w64-mingw32-objdump")
-    assert objdump, "the mingw-w64 cross compiler (Debian gcc-mingw-w64-x86-64) is not installed: .ci/run installs it"
+    objdump, _ = tools("x86_64-w64-mingw32-objdump", "x86_64-w64-mingw32-gcc",
+                       why="the mingw-w64 cross compiler, Debian gcc-mingw-w64-x86-64, makes the win64 DLL")
     fmu = compiled["moored_barge"] / "moored_barge_barge.fmu"
     with zipfile.ZipFile(fmu) as z:
         names = z.namelist()
@@ -559,8 +559,7 @@ def test_win64_binary_runs_under_wine_as_the_linux_one(compiled, tmp_path):
     FMU with state-space memories under wine: its outputs equal the linux64 binary's under
     fmpy, same inputs."""
     from test_native import fmpy_reference, unzip
-    wine, cc = shutil.which("wine"), shutil.which("x86_64-w64-mingw32-gcc")
-    assert wine and cc, "wine and the mingw-w64 cross compiler are installed by .ci/run"
+    wine, cc = tools("wine", "x86_64-w64-mingw32-gcc", why="the win64 DLL run under wine, Debian wine64")
     host = tmp_path / "win_host.exe"
     from hydrofmu.bench import native
     subprocess.run([cc, "-O1", f"-I{native.SOURCE.parent}", "-o", str(host), str(NATIVE / "win_host.c")], check=True)

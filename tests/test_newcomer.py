@@ -2,6 +2,8 @@
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 
@@ -98,3 +100,21 @@ def test_bem_quality_plot_has_y_units_and_readable_text(tmp_path, monkeypatch):
     assert ("B: cyl1__Roll, cyl1__Roll", "B [kg·m²/s]") in labels
     assert ("A: cyl1__Sway, cyl1__Roll", "A [kg·m]") in labels
     assert min(a.title.get_fontsize() for a in fig.axes) >= 9
+
+
+def test_a_missing_cross_compiler_skips_on_a_fresh_machine_and_fails_in_ci(tmp_path, monkeypatch):
+    """A machine with Python and cc only (the README's prerequisites): a test that needs
+    mingw-w64 or wine is skipped with its reason in one line; in CI (CI=true, .ci/run
+    installs them) the same test fails."""
+    from conftest import tools
+    monkeypatch.setenv("PATH", str(tmp_path))   # nothing to be found
+    monkeypatch.delenv("CI", raising=False)
+    with pytest.raises(pytest.skip.Exception) as skipped:
+        tools("wine", "x86_64-w64-mingw32-gcc", why="the win64 DLL run under wine")
+    reason = str(skipped.value)
+    assert "\n" not in reason and reason.startswith("needs wine and x86_64-w64-mingw32-gcc (the win64 DLL")
+    monkeypatch.setenv("CI", "true")
+    with pytest.raises(pytest.fail.Exception) as failed:
+        tools("wine", why="the win64 DLL run under wine")
+    assert str(failed.value).startswith("CI=true but needs wine")
+    assert "export CI=true" in (ROOT / ".ci" / "run").read_text()
