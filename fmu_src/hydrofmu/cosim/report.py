@@ -134,13 +134,13 @@ ROUND_OFF = 1e-9                    # a panel whose values are all below this sh
 
 
 def time_axis(t):
-    """(times in the plot's unit, its label): seconds up to 20 minutes, minutes up to 3 hours,
+    """(times in the plot's unit, its label): seconds up to 15 minutes, minutes up to 3 hours,
     then hours (a 30-minute record reads 0–30 min, not 0–1800 s)."""
     t = np.asarray(t, float)
     span = float(t[-1] - t[0]) if t.size else 0.0
     if span > 3 * 3600:
         return t / 3600, "time [h]"
-    if span > 1200:
+    if span > 900:
         return t / 60, "time [min]"
     return t, "time [s]"
 
@@ -165,10 +165,16 @@ def _panel(ax, t, curves, title, colours, robust=True, scale=0.0, floor=0.0, uni
     ``scale`` or ``floor``) says so with their size in ``unit`` instead of magnifying them.
     ``legend``: labels of the curves, drawn in the panel."""
     noise = round_off(curves, scale, floor)
-    for k, (effect, comp, y) in enumerate(curves):
-        ax.plot(t, y, color=colours.get(effect, effect if effect in DOF_COLOURS + (ELEVATION,) else "black"),
-                ls=LINESTYLES[comp] if legend is None else "-", lw=2.0 if effect == TOTAL else 1.2,
-                label=legend[k] if legend is not None else None)
+    lines = {}
+    # a legend's curves drawn widest first: the smaller ones stay on top (roll under pitch hid)
+    order = (sorted(range(len(curves)), key=lambda k: -float(np.nanmax(curves[k][2]) - np.nanmin(curves[k][2])))
+             if legend is not None and curves and all(np.size(y) for _, _, y in curves) else range(len(curves)))
+    for k in order:
+        effect, comp, y = curves[k]
+        lines[k], = ax.plot(t, y, color=colours.get(effect, effect if effect in DOF_COLOURS + (ELEVATION,) else "black"),
+                            ls=LINESTYLES[comp] if legend is None else "-",
+                            lw=2.0 if effect == TOTAL else 1.0 if legend is not None else 1.2,
+                            label=legend[k] if legend is not None else None)
     ax.grid(True, alpha=0.3)
     if curves and (noise is not None or all(np.all(np.asarray(y) == 0) for _, _, y in curves)):
         # nothing to see: say so instead of an empty ±1 axis or magnified round-off
@@ -183,7 +189,8 @@ def _panel(ax, t, curves, title, colours, robust=True, scale=0.0, floor=0.0, uni
         if clipped:   # in the title, where it covers no data and no tick label
             title += f"\naxis clipped to the settled run; data span {clipped[0]:.3g} … {clipped[1]:.3g}"
     if legend is not None and curves:
-        ax.legend(fontsize=7, loc="upper right", ncol=len(curves), framealpha=0.7, handlelength=1.5)
+        ax.legend(handles=[lines[k] for k in range(len(curves))], fontsize=7, loc="upper right", ncol=len(curves),
+                  framealpha=0.7, handlelength=1.5)
     ax.set_title(title, fontsize=9)
 
 
@@ -213,7 +220,7 @@ def plot(result, manifest, path):
     [kN].  In the load panels colour = effect (the same in every panel, ``total`` black) and
     line style = component (x solid, y dashed, z dotted).  A panel of round-off (a moment of
     1e-13 kN·m beside thousands) says so instead of magnifying it; the time axis is in
-    minutes past 20 minutes of record, in hours past 3 hours.
+    minutes past 15 minutes of record, in hours past 3 hours.
     """
     import matplotlib
     matplotlib.use("Agg")
