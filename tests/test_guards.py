@@ -488,3 +488,19 @@ def test_a_broken_build_folder_is_named_not_an_internal_error(tmp_path, demo_bui
         assert code == 2 and words in line and not (tmp_path / "r.csv").exists()
         with pytest.raises(InputError, match=words.split(": ", 1)[1]):
             hydrofmu.run(folder)
+
+
+def test_one_mismatch_is_stated_once_with_plain_numbers(tmp_path):
+    """The buoy of models/ 1 m below the rotation centre of its BEM file, which a coupling and
+    two effects read: one statement of that mismatch (not one per reader, nor the centre of
+    mass that moved with it), numbers printed as numbers (no np.float64 reprs)."""
+    text = (MODELS / "buoy_in_waves.toml").read_text().replace(
+        '"decks/buoy.nc"', f'"{(MODELS / "decks" / "buoy.nc").as_posix()}"').replace(
+        "position = [0.0, 0.0, 0.0]", "position = [0.0, 0.0, -1.0]")
+    path = write_scene(tmp_path, text, "moved.toml")
+    code, line, _ = cli("build", "--check", path)
+    assert code == 2 and line.count("rotation_center") == 1 and line.count("; ") == 0, line
+    assert "np.float64" not in line and "center_of_mass" not in line
+    assert "rotation_center[buoy]: [0, 0, 0] m in the file but the reference point of scene body 'buoy' is at " \
+           "[0, 0, -1] m (bodies.buoy.position)" in line
+    assert len(line) < 400, len(line)
