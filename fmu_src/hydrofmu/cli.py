@@ -93,7 +93,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
     t ≥ ``transient``.  fmpy runs stream their rows into the CSV and ``parquet`` (default:
     beside the CSV when pyarrow is installed) as they go, and the PNG and the summary are
-    read from the file; a libcosim run is written after it ends.  A write that fails after
+    read from the file; a libcosim run writes the same files after it ends.  A write that fails after
     the run goes to a fallback folder: ``written`` maps each asked path to the one written."""
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
@@ -106,8 +106,11 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
+    if parquet is None and csv is not None and _has_pyarrow():
+        parquet = Path(csv).with_suffix(".parquet")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
+        check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))
         say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
         try:
             result = run(folder, **kw)
@@ -116,11 +119,12 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         result.written = {}
         if csv:
             result.written[Path(csv)] = keep(result.to_csv, csv, log)[0]
+        if parquet:   # the files an fmpy run writes, written when the run ends
+            from .cosim.stream import write_parquet
+            result.written[Path(parquet)] = write_parquet(result, parquet, log)
         return _plot_and_summary(result, png, summary, transient, log)
     from .cosim.master import run
     from .cosim.stream import Sink
-    if parquet is None and csv is not None and _has_pyarrow():
-        parquet = Path(csv).with_suffix(".parquet")
     check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
     from .cosim.master import RunError
@@ -476,6 +480,7 @@ def main(argv=None):
     """The command line; returns the exit code: 0 done, 1 a run or validation failed,
     2 bad input (one ``error:`` line naming the file, line or key path and field),
     3 an internal error (one line; HYDROFMU_DEBUG=1 shows the traceback)."""
+    _SAID.clear()
     with warnings.catch_warnings():
         warnings.simplefilter("always", InputWarning)
         warnings.showwarning = _show_warning
@@ -495,11 +500,20 @@ def main(argv=None):
             return 3
 
 
+# the warnings this command said: each once, however often the scene is read (tune and batch
+# read it once per candidate or variant)
+_SAID = set()
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    if issubclass(category, InputWarning):
-        print(f"warning: {message}", file=sys.stderr)
-    else:
-        print(f"warning: {category.__name__}: {message}", file=sys.stderr)
+    _say_warning(f"warning: {message}" if issubclass(category, InputWarning) else
+                 f"warning: {category.__name__}: {message}")
+
+
+def _say_warning(text):
+    if text not in _SAID:
+        _SAID.add(text)
+        print(text, file=sys.stderr)
 
 
 def _main(argv):
@@ -517,6 +531,8 @@ def _main(argv):
         if reuse is not None:
             folder = reuse
             print(f"reusing {folder}: the scene, its decks and hydrofmu are unchanged since it was built")
+            for text in read_manifest(folder).get("warnings", []):   # the build's: said again, once
+                _say_warning(f"warning: {text}")
         elif folder.suffix == ".toml":
             from .scene import load_scene
             scene = load_scene(folder)

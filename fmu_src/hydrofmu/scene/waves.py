@@ -7,6 +7,7 @@ import numpy as np
 
 from .. import keys
 from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_problems, size_problem
+from ..errors import numbers
 from .couplings import CENTRE_TOL
 
 WAVE_KEYS = keys.names(keys.WAVES)
@@ -103,10 +104,15 @@ def check_wave_effects(problems, bodies, sea, rho, g):
                    for k, v in (("rho", rho), ("g", g)) if d.get(k) is not None and v is not None
                    and abs(d[k] - v) > 1e-6 * v]
             centre = d.get("rotation_center")
+            fact = ("rotation_center", str(Path(d["bem"]).resolve()), d["body"])
             if centre is not None and np.max(np.abs(np.subtract(centre, body.position))) > CENTRE_TOL:
-                bad.append(f"rotation_center of {d['body']!r} in {name} is {centre} m but the reference point of body "
-                           f"{body.name!r} is at {body.position} m: the transfer functions are about the rotation centre "
-                           f"and their phases refer to the body's place (move the body or solve again)")
+                # one statement per mismatch: the coupling or the other effect of this file may have made it
+                problems.add_once(fact, f"{where}.bem",
+                                  f"{Path(d['bem']).resolve()}: rotation_center[{d['body']}]: {numbers(centre)} m in the "
+                                  f"file but the reference point of scene body {body.name!r} is at "
+                                  f"{numbers(body.position)} m (bodies.{body.name}.position): the coefficients are about "
+                                  f"the rotation centre and the wave phases refer to the body's place (move the body "
+                                  f"there, or solve again about its reference point)")
             if eff.type == "wave_excitation":
                 mismatch = depth_mismatch(d.get("water_depth"), sea.depth if sea is not None else None)
                 if mismatch:
@@ -121,7 +127,8 @@ def check_wave_effects(problems, bodies, sea, rho, g):
                     except WaveError as exc:
                         bad.append(f"{name}: {exc}")
             else:
-                bad += _hydrostatic_problems(d, body, name, rotation)
+                # a body away from the rotation centre has its centre of mass away too: said once, above
+                bad += _hydrostatic_problems(d, body, name, rotation, centre_said=fact in problems.facts)
                 d["position0"], d["attitude0"] = list(body.position or [0.0] * 3), list(body.attitude or [0.0] * 3)
             for message in bad:
                 problems.add(f"{where}.bem", message)
@@ -151,7 +158,7 @@ def check_wave_effects(problems, bodies, sea, rho, g):
 MASS_TOL = 0.01   # relative: the BEM result's mass against the scene's
 
 
-def _hydrostatic_problems(d, body, name, rotation):
+def _hydrostatic_problems(d, body, name, rotation, centre_said=False):
     """What makes a BEM hydrostatic matrix wrong for this scene body (messages)."""
     bad = []
     if not d["weight"]:
@@ -161,10 +168,10 @@ def _hydrostatic_problems(d, body, name, rotation):
         bad.append(f"mass = {d['mass']:.6g} kg in {name} (its restoring's weight terms) but {body.mass:.6g} kg in the "
                    f"scene (bodies.{body.name}.mass)")
     com = d.get("center_of_mass")
-    if com is not None and None not in (body.position, body.attitude, body.cog):
+    if com is not None and None not in (body.position, body.attitude, body.cog) and not centre_said:
         scene_com = np.add(body.position, rotation(body.attitude) @ np.asarray(body.cog, float))
         if np.max(np.abs(scene_com - com)) > CENTRE_TOL:
-            bad.append(f"center_of_mass = {com} m in {name} but {scene_com.round(6).tolist()} m in the scene "
+            bad.append(f"center_of_mass = {numbers(com)} m in {name} but {numbers(scene_com)} m in the scene "
                        f"(bodies.{body.name}.position + cog)")
     k = np.asarray(body.stiffness if body.stiffness is not None else np.zeros((6, 6)))
     vertical = [2, 3, 4]
