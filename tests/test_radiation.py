@@ -160,3 +160,21 @@ def test_tail_warning_names_the_pairs_that_matter_once():
     assert "for 2 dof pair(s)" in tails[0] and "(a, a)" in tails[0] and "(b, b)" in tails[0], tails
     assert "(a, b)" not in tails[0] and "higher frequencies" in tails[0]
     assert r.active[0, 1] and r.tail_share[0, 1] < 1e-3 < 0.05 < r.tail_share[0, 0]
+
+
+def test_the_command_line_says_each_warning_once(monkeypatch, capsys):
+    """`tune` and `batch` read the scene again per case: the command line prints each distinct
+    warning once per command (here the same InputWarning raised three times, another once)."""
+    import warnings
+    from hydrofmu import cli
+    from hydrofmu.errors import InputWarning
+
+    def noisy(argv):
+        for text in ("the tail beyond …", "the tail beyond …", "another", "the tail beyond …"):
+            warnings.warn(InputWarning("scene.toml", None, "couplings[1].bem", text))
+        return 0
+    monkeypatch.setattr(cli, "_main", noisy)
+    assert cli.main(["build"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("the tail beyond") == 1 and err.count("another") == 1, err
+    assert cli.main(["build"]) == 0 and capsys.readouterr().err.count("the tail beyond") == 1   # per command
