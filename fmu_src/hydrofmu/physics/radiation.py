@@ -13,7 +13,8 @@ between samples, zero after the last).  Method (stated in the README):
   values; above ω_N: a power tail B_ij(ω) = B_ij(ω_N)·(ω_N/ω)^((p_i + p_j)/2) (the tail matrix
   is D·B(ω_N)·D with D = diag((ω_N/ω)^(p_i/2)): positive semi-definite when B(ω_N) is),
   integrated on a geometric grid up to TAIL_SPAN·ω_N.  Each dof's exponent p_i (P_MIN…P_MAX
-  by P_STEP) is the one whose rebuilt A_ii(ω) agrees best with the database over the grid
+  by P_STEP) is the one whose rebuilt A_ii(ω) agrees best with the database over the grid (the
+  smallest mean |error|)
   (A in the band carries B beyond it, Kramers–Kronig).  Between dofs of different bodies
   (``groups``) the tail decays faster, by (ω_N/ω)^q more: the cross-body B oscillates with
   ω (the waves travel between the bodies, a phase k·d), so beyond the grid its integral mostly
@@ -30,8 +31,10 @@ between samples, zero after the last).  Method (stated in the README):
   by more than DECAY of the curve's peak (searched up to the 2π/Δω the grid's spacing
   resolves), unless asked.
 - A∞: Ogilvie's relation A∞ = A(ω) + (1/ω)·∫₀^L K(t)·sin(ωt) dt with the sampled kernel, the
-  midrange over all grid frequencies (the constant that makes the worst A error smallest), so
-  A∞ and K are consistent; the file's infinite-frequency value is reported against it, and used
+  midrange over all grid frequencies (the constant that makes the worst A error smallest) when
+  those values spread by at most BALANCE of √(A_ii·A_jj), else their median (a resonance
+  between grid points made a few frequencies miss by tens of %, and the midrange moved A∞ by
+  half that everywhere), so A∞ and K are consistent; the file's infinite-frequency value is reported against it, and used
   instead only when asked (``a_inf_from="file"``): with a grid that stops at ω_N, the kernel
   misses what B does beyond, and the file's A∞ then shifts the rebuilt A(ω) by that.
 - Symmetry: A∞, A(ω) and B(ω) are symmetrised; an A∞ asymmetry |A_ij − A_ji| above
@@ -41,7 +44,8 @@ between samples, zero after the last).  Method (stated in the README):
 Quality: A(ω) = A∞ − (1/ω)·∫K̃(t)·sin(ωt) dt and B(ω) = ∫K̃(t)·cos(ωt) dt rebuilt from the
 sampled kernel K̃ exactly as the FMU convolves it, compared with the database at its own
 frequencies: worst error in % of each curve's peak, and in % of the pair's scale
-√(peak_ii·peak_jj) (the diagonal curves' peaks); ``tail_share`` = share of ∫|B| dω beyond ω_N.
+√(peak_ii·peak_jj) (the diagonal curves' peaks); ``tail_share`` = ∫|B_ij| dω beyond ω_N over
+√(∫|B_ii| dω·∫|B_jj| dω) (a pair against its two dofs' whole damping: noise is not a share).
 """
 import time
 from dataclasses import dataclass, field
@@ -89,7 +93,7 @@ class Radiation:
     active (n, n) bool: the pairs kept; omega, a_db, b_db: the (symmetrised) database;
     a_fit, b_fit: the same rebuilt from (a_inf, kernels); err_a, err_b (n, n): worst error in %
     of each curve's peak; pair_a, pair_b (n, n): the same in % of √(peak_ii·peak_jj);
-    tail_share (n, n); tail_exponents (n,); notes: what the transform decided (text lines).
+    tail_share (n, n): ∫|B_ij| beyond ω_N / √(∫|B_ii|·∫|B_jj|); tail_exponents (n,); notes: what the transform decided (text lines).
     """
     a_inf: np.ndarray
     timdel: float
