@@ -483,7 +483,13 @@ def main(argv=None):
     _SAID.clear()
     with warnings.catch_warnings():
         warnings.simplefilter("always", InputWarning)
-        warnings.showwarning = _show_warning
+        said = set()   # each warning once per command: `tune` and `batch` read the scene again per case
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if str(message) not in said:
+                said.add(str(message))
+                _show_warning(message, category, filename, lineno, file, line)
+        warnings.showwarning = show
         try:
             return _main(argv)
         except InputError as exc:
