@@ -134,6 +134,32 @@ def _knobs(p, table, where, seen=None):
     return out
 
 
+def _kind(value):
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    return "a string" if isinstance(value, str) else "an array" if isinstance(value, list) else "a table"
+
+
+def _one_kind(p, where, key, values):
+    """The values of one knob: one kind (the table's column holds one type: a string among
+    numbers ended the batch after every case had run), and numbers where the knob is an FMU
+    parameter (``instance.variable``, or a scene key the FMUs expose as one).  Recorded in
+    ``p`` naming the key and the value, before any case runs."""
+    first = key.split(".", 1)[0].split("[", 1)[0]
+    real = key in EXPOSED or (first not in SCENE_SECTIONS and "." in key and not key.startswith("run."))
+    for value in values:
+        if real and _kind(value) != "a number":   # NaN passes: the case fails, the others run
+            p.add(where, f"value {value!r} is not a number: {key} is a real parameter of the FMUs")
+            return
+    kinds = [_kind(v) for v in values]
+    odd = next((k for k, kind in enumerate(kinds) if kind != kinds[0]), None)
+    if odd is not None:
+        p.add(where, f"value {values[odd]!r} is {kinds[odd]} among {kinds[0].split()[1]}s ({values[0]!r}, …): every case's "
+                     "value of a knob is one kind (the table's column)")
+
+
 def load_cases(source, base=None) -> Batch:
     """Read and check a case file (path) or the same content as a dict (paths in it relative
     to ``base``, default the current folder).  Raises one InputError naming every problem."""
@@ -179,6 +205,7 @@ def load_cases(source, base=None) -> Batch:
         again = next((v for k, v in enumerate(values) if v in values[:k]), None)
         if again is not None:
             p.add(f"matrix.{key}", f"value {again!r} given twice (two cases would be one)")
+        _one_kind(p, f"matrix.{key}", key, values)
         matrix[key] = values
     extra = doc.get("cases", [])
     if not isinstance(extra, list) or not all(isinstance(c, dict) for c in extra):
@@ -186,6 +213,9 @@ def load_cases(source, base=None) -> Batch:
         extra = []
     # a single case may override a shared knob (its own value), not give one twice itself
     extra = [_knobs(p, c, f"cases[{i}]") for i, c in enumerate(extra)]
+    for where, knobs in [("set", fixed)] + [(f"cases[{i}]", c) for i, c in enumerate(extra)]:
+        for key, value in knobs.items():
+            _one_kind(p, f"{where}.{key}", key, [value])
     # the algorithm is one knob wherever it is written: checked the same in every table
     for where, value in ([("set.run.algorithm", fixed.get("run.algorithm"))]
                          + [("matrix.run.algorithm", v) for v in matrix.get("run.algorithm", [])]
@@ -289,6 +319,9 @@ def _check_scene_keys(batch, first):
     try:
         load_scene(batch.scene, first)
     except InputError as exc:
+        if exc.field in first:      # the knob's own value is refused by the scene: every case would be
+            raise InputError(batch.path, None, exc.field, f"value {first[exc.field]!r}: "
+                                                          f"{exc.message.split('; ')[0]}") from None
         for key in first:
             if key in getattr(exc, "unknown", {}):
                 parent = key.rsplit(".", 1)[0]

@@ -230,7 +230,7 @@ def validate(paths):
 
 
 def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_length=None,
-             symmetry_tolerance=None, png=None, log=print, a_inf="ogilvie"):
+             symmetry_tolerance=None, png=None, log=print, a_inf="ogilvie", period_variable=None):
     """A BEM result (Capytaine .nc, WAMIT .1) → a SIMO deck with every self and cross coupling
     of its bodies (BODY DATA groups first); the transform's report goes to ``log``."""
     from .bem import couplings, plot_quality, write_simo
@@ -245,7 +245,7 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
                                                          "Capytaine dataset carries its own rho")
     rho = 1025.0 if rho is None else rho
     check_outputs(files=(out,), plots=(png,), inputs=(result,))
-    data = read_bem(result, ulen=ulen, rho=rho)
+    data = read_bem(result, ulen=ulen, rho=rho, g=9.81, period_variable=period_variable)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
                      SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance, a_inf_from=a_inf)
     for line in made.report():
@@ -465,6 +465,9 @@ def make_parser():
     m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
     m.add_argument("--a-inf", choices=("ogilvie", "file"), default="ogilvie",
                    help="A∞ from Ogilvie's relation, consistent with the kernels (default), or the file's ω = ∞ value")
+    m.add_argument("--period-variable", choices=("period", "omega", "wavenumber", "hz"),
+                   help="WAMIT: what the file's first column is, as the run's IPEROUT wrote it (default period; "
+                        "wavenumber: KL = ω²L/g with g = 9.81)")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     return parser
 
@@ -557,7 +560,7 @@ def _main(argv):
         return code
     elif args.command == "bem2simo":
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
-                        args.symmetry_tolerance, args.png, a_inf=args.a_inf)
+                        args.symmetry_tolerance, args.png, a_inf=args.a_inf, period_variable=args.period_variable)
         return _wrote(made)[1]
     elif args.command == "bench":
         from .bench.run import main as bench

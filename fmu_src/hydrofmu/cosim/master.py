@@ -26,7 +26,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
-from ..admissible import whole_steps
+from ..admissible import size_problem, whole_steps
 from ..errors import InputError
 from ..names import unknown
 from .manifest import read_manifest
@@ -416,6 +416,11 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                                             if c == "parameter" or (c == "input" and f"{name}.{v}" not in connected)],
                         "run", "parameters", "parameter or unconnected input")
         settings = run_settings(system.manifest, step, algorithm, stop)
+        too_big = None if sink is not None else size_problem((n // thin + 1) * (len(record) + 1), 8, "output values")
+        if too_big:   # the rows are one array in memory: said before it is allocated, not a MemoryError
+            raise InputError(system.manifest.get("source", "run"), None, "run.stop",
+                             f"{too_big} ({n // thin + 1:.4g} rows of {len(record)} outputs): record fewer outputs "
+                             "(run.outputs), a coarser run.interval, a shorter run.stop, or write to a file (--csv)")
         rows = Recorder(n, step, len(record), thin, sink)
         if sink is not None:
             sink.open(record, system.units(record), system.manifest, {**settings, "output_interval": thin * step})

@@ -98,10 +98,11 @@ def _load_scene(path, overrides=None):
         joint = read_joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
-    couplings = (read_couplings(p, doc["couplings"], bodies, run_cfg["memory"], {"rho": rho, "g": g})
+    sea = read_waves(p, doc["waves"]) if "waves" in doc else None   # before the couplings: its depth
+    couplings = (read_couplings(p, doc["couplings"], bodies, run_cfg["memory"],
+                                {"rho": rho, "g": g, "depth": sea.depth if sea is not None else None})
                  if "couplings" in doc else [])
     speed, direction, profile = read_current(p, env)
-    sea = read_waves(p, doc["waves"]) if "waves" in doc else None
     check_wave_effects(p, bodies, sea, rho, g)
     _check_names(p, bodies, joints, couplings)
     if None not in (run_cfg["step"], run_cfg["stop"]):
