@@ -383,11 +383,15 @@ def test_state_serialize_and_reset_continue_exactly(compiled, wave_builds, tmp_p
         outs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
         start = [float(v.start or 0.0) for v in md.modelVariables if v.causality == "input"]
 
+        # the dynamics FMU alone, its loads held near their start values, rolls a random body
+        # past 90° (capsized: the step fails) at 3.5 s: its 60 steps cover 3 s
+        h = 0.05 if "dynamics" in fmu.name else 0.1
+
         def run(slave, first, n):
             rows = []
             for k in range(first, first + n):
                 slave.setReal(ins, [x + 0.1 * np.sin(0.3 * k + j) for j, x in enumerate(start)])
-                slave.doStep(0.1 * k, 0.1)
+                slave.doStep(h * k, h)
                 rows.append(slave.getReal(outs))
             return np.array(rows)
 

@@ -312,6 +312,35 @@ def test_irregular_response_std_matches_spectral_integral(folder):
         assert res[name][after].std() == pytest.approx(want, rel=0.05), name
 
 
+def test_a_sea_state_runs_right_with_the_defaults(folder):
+    """The irregular sea above with no run knob but the stop: the scene gets the linear hold, a
+    ramp of 3 peak periods (15 s) and the 0.1 s step (its BEM restoring's fastest dry mode,
+    1.75 rad/s, keeps the hold within 0.1 % of critical), and the heave and pitch standard
+    deviations come within 5 % of √∫|X(ω)|²S(ω)dω.  The old default (constant hold) is far off:
+    its half-step lag drives the pitch mode (physics.hold)."""
+    from hydrofmu.physics import waves
+    w, x, _ = frequency_domain(ONE, DAMPING)
+    sea = 'spectrum = "jonswap"\nhs = 0.2\ntp = 5.0\ngamma = 3.3\ncomponents = 100\nseed = 11'
+    text = scene_text(ONE, {"cyl": 0.0}, DAMPING, sea, step=0.1, stop=1280.0)
+    text = text.replace("step = 0.1\n", "", 1).replace("substep = 0.1\n", "").replace('load_hold = "linear"\n', "")
+    fine = np.linspace(w[0], w[-1], 4000)
+    s = waves.spectrum(fine, 0.2, 5.0, 3.3)
+    for hold in (None, "constant"):
+        scene = load_scene(write_scene(folder, text.replace("[run]\n", "[run]\n" + (f'load_hold = "{hold}"\nstep = 0.1\n'
+                                                                                  if hold else "")), "defaults"))
+        if hold is None:
+            assert (scene.run["load_hold"], scene.run["step"], scene.waves.ramp) == ("linear", 0.1, 15.0)
+            assert any("linear load hold" in c for c in scene.run["chosen"])
+        res = run(inprocess.system(scene), progress=False, record=["cyl_dynamics.position[3]", "cyl_dynamics.attitude[2]"])
+        after = res.time >= 80.0
+        for name, dof in (("cyl_dynamics.position[3]", 2), ("cyl_dynamics.attitude[2]", 4)):
+            want = math.sqrt(np.trapezoid(np.interp(fine, w, np.abs(x[:, dof])) ** 2 * s, fine))
+            if hold is None:
+                assert res[name][after].std() == pytest.approx(want, rel=0.05), name
+            else:
+                assert res[name][after].std() > 2 * want, name
+
+
 def test_built_fmus_run_the_waves(folder, tmp_path):
     """The same scene built into FMUs and run by fmpy: the held-still excitation of the
     in-process slaves, to round-off, and the BEM transfer function times the amplitude."""

@@ -107,7 +107,7 @@ def _load_scene(path, overrides=None):
     _check_names(p, bodies, joints, couplings)
     if None not in (run_cfg["step"], run_cfg["stop"]):
         stable_defaults(run_cfg, bodies, couplings, sea,
-                        isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"])
+                        isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"], joints)
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
