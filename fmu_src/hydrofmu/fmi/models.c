@@ -179,6 +179,7 @@ typedef struct {
     EnvRefs env;
     const double *waves, *transfer;        /* the 'waves' and 'transfer' records (NULL: no waves) */
     double *wave;                          /* waves.c's per-step parameters (NULL: not drawn yet) */
+    HfPhasors *phasors;                    /* the FMU's one set of wave phasors (with wave) */
     int wave_force, wave_elevation;
     Effect *effects;
     int neffects;
@@ -191,6 +192,7 @@ static void load_release(Instance *inst) {
     if (!L) return;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) memory_free(&L->couplings[k].memory);
+    hf_phasors_delete(L->phasors);
     free(L->effects), free(L->couplings), free(L->wave), free(L);
     inst->data = NULL;
 }
@@ -251,9 +253,14 @@ static int draw_waves(Instance *inst, Load *L) {
     HfSea sea = {ivr(w[3]), knob[0], knob[1], knob[2], knob[3], knob[4], knob[5], knob[6], knob[7], knob[8], knob[9],
                  knob[10], w[4]};
     char field[16] = "", message[400] = "";
-    free(L->wave);
+    hf_phasors_delete(L->phasors), free(L->wave);
+    L->phasors = NULL;
     L->wave = hf_wave_build(&sea, L->transfer, v[ivr(w[2])], field, message, sizeof message);
     if (!L->wave) hf_fail(inst, "waves.%s: %s", field, message);
+    else if (!(L->phasors = hf_wave_phasors(L->wave))) {
+        free(L->wave), L->wave = NULL;
+        hf_fail(inst, "out of memory for the wave phasors");
+    }
     return L->wave ? 0 : -1;
 }
 
@@ -321,7 +328,7 @@ static void load_evaluate(Instance *inst) {
             hf_set_error(inst, "the waves.* parameters are not a usable sea state");
             return;
         }
-        hf_waves(L->wave, inst->has_next ? inst->next_time : 0.0, w);
+        hf_waves(L->wave, L->phasors, inst->has_next ? inst->next_time : 0.0, w);
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }

@@ -73,12 +73,31 @@ typedef struct {
 /* 0, or -1 with the bad knob's name in field (16 chars) and why in message */
 int hf_sea_check(const HfSea *sea, char *field, char *message, size_t size);
 double hf_wave_number(double omega, double g, double depth);
-/* the per-step parameters [n, ramp length, omega (n), table (2n x 7)] (malloc'd; NULL: field and
- * message say why) of a sea state and a transfer function [window_lo, window_hi, x, y, closed, nw,
- * nb, omega (nw), directions (nb), re (nw nb 6), im (nw nb 6)] (TransferFunction.c_params) */
+/* the per-step parameters [n, ramp length, omega (n), a e^{i phi} (n (re, im) pairs), table (2n x 7)]
+ * (malloc'd; NULL: field and message say why) of a sea state and a transfer function [window_lo,
+ * window_hi, x, y, closed, nw, nb, omega (nw), directions (nb), re (nw nb 6), im (nw nb 6)]
+ * (TransferFunction.c_params) */
 double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *field, char *message, size_t size);
-/* out: [F (6), elevation] at time t */
-void hf_waves(const double *params, double t, double *out);
+/* The shared per-step phasors (waves.Phasors): p (n (re, im) pairs) = a_k e^{i(w_k t + phi_k)} at
+ * time t, advanced by one complex multiply per component per step, exact every HF_RESYNC steps
+ * and off the step grid; one per FMU, every wave effect reads it. */
+#define HF_RESYNC 1024     /* waves.RESYNC */
+#define HF_GRID_ULPS 4     /* waves.GRID_ULPS */
+typedef struct {
+    int n, resync, j, has_rot;
+    double ramp, t, sync, h;
+    const double *omega, *amp;   /* (not owned) */
+    double *p, *rot;
+    long exact, rotations;
+} HfPhasors;
+HfPhasors *hf_phasors_new(const double *omega, const double *amp, int n, double ramp, int resync);
+void hf_phasors_delete(HfPhasors *P);
+const double *hf_phasors_at(HfPhasors *P, double t);
+double hf_phasors_ramp(const HfPhasors *P);   /* r(t) at the phasors' time */
+/* the phasors of hf_wave_build's parameters (which they point into) */
+HfPhasors *hf_wave_phasors(const double *params);
+/* out: [F (6), elevation] at time t (advances P to t) */
+void hf_waves(const double *params, HfPhasors *P, double t, double *out);
 
 /* hydrostatics.c: params [C (36, row-major), position0 (3), yaw0, vertical0 (3)]: F = -C delta */
 void hf_hydrostatics(const double *params, const HfMotion *m, double *out);
