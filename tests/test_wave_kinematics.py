@@ -194,3 +194,52 @@ def test_wave_load_with_shared_phasors_equals_the_direct_sum():
         assert eta == pytest.approx(want, abs=1e-12 * comps.amplitude.sum())
         assert row[7] == pytest.approx(want, abs=1e-12 * comps.amplitude.sum())
     assert ph.exact + ph.rotations == 400
+
+
+def test_compiled_kinematics_equal_the_python_ones():
+    """physics/wave_kinematics.c (compiled alone with waves.c) against the Python kernel: every
+    stretching, deep and finite depth, points below, above the mean level and out of the water,
+    moving and fixed, through the compiled phasors, to 1e-12 of each output's range."""
+    import ctypes
+    from pathlib import Path
+    from hydrofmu.cc import cached_many
+    from hydrofmu.physics.wave_kinematics import STRETCHING
+    physics = Path(waves.__file__).parent
+    lib = ctypes.CDLL(str(cached_many([physics / "waves.c", physics / "wave_kinematics.c"], "kin_kernel",
+                                      libs=["-lm"], flags=["-O2", "-shared", "-fPIC", "-std=c99"])))
+    lib.hf_kin_build.restype = ctypes.POINTER(ctypes.c_double)
+    for name in ("hf_phasors_new", "hf_kin_point_new"):
+        getattr(lib, name).restype = ctypes.c_void_p
+    lib.hf_phasors_at.restype = ctypes.POINTER(ctypes.c_double)
+    lib.hf_phasors_ramp.restype = ctypes.c_double
+    D = ctypes.c_double
+    sea = SeaState("jonswap", hs=3.0, tp=9.0, components=40, seed=5, spreading=3.0, ramp=8.0)
+    comps = waves.components(sea)
+    n = comps.omega.size
+    arr = lambda x: (D * len(x))(*x)   # noqa: E731
+    omega, amp = arr(comps.omega.tolist()), arr((comps.amplitude * np.exp(1j * comps.phase)).view(float).tolist())
+    rng = np.random.default_rng(2)
+    for depth in (math.inf, 25.0):
+        for code, name in enumerate(STRETCHING):
+            kin = WaveKinematics(comps, G, depth, name)
+            ph = Phasors(comps, sea.ramp)
+            params = lib.hf_kin_build(omega, arr(comps.direction.tolist()), n, D(G), D(depth), code)
+            cph = ctypes.c_void_p(lib.hf_phasors_new(omega, amp, n, D(sea.ramp), waves.RESYNC))
+            cache = ctypes.c_void_p(lib.hf_kin_point_new(n))
+            out = (D * 8)()
+            got, ref = [], []
+            fixed = (3.0, -2.0, -4.0)
+            for i in range(300):
+                t = 0.1 * i
+                x = fixed if i % 3 else (rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(-6.0, 2.5))
+                p = lib.hf_phasors_at(cph, D(t))
+                lib.hf_kin_at(params, cache, p, D(lib.hf_phasors_ramp(cph)), arr(list(x)), D(RHO), out)
+                got.append(list(out))
+                ref.append(kin.at(ph.at(t), ph.ramp_factor, [x], RHO)[0])
+            got, ref = np.array(got), np.array(ref)
+            span = ref.max(axis=0) - ref.min(axis=0)
+            assert (span > 0).all() and np.all(np.abs(got - ref) <= 1e-12 * span), (depth, name)
+            assert (ref[:, 0] == 0).sum() > 5   # some points were out of the water
+            lib.hf_kin_point_delete(cache), lib.hf_phasors_delete(cph)
+            ctypes.CDLL(None).free(params)
+

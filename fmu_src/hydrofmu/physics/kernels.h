@@ -99,6 +99,21 @@ HfPhasors *hf_wave_phasors(const double *params);
 /* out: [F (6), elevation] at time t (advances P to t) */
 void hf_waves(const double *params, HfPhasors *P, double t, double *out);
 
+/* wave_kinematics.c: Airy kinematics of the components at a point.  params [n, g, depth,
+ * stretching (0 none, 1 vertical, 2 wheeler, 3 extrapolation), omega (n), k (n), cos beta (n),
+ * sin beta (n)] (malloc'd by hf_kin_build); a point's cache of its factors (one per point);
+ * out [u (3), a (3), dynamic pressure, elevation] at x (3, global) from the phasors p and ramp r */
+#define HF_STRETCHING {"none", "vertical", "wheeler", "extrapolation"}
+typedef struct {
+    double x, y, z;
+    double *e, *fh, *fv, *fp;
+} HfKinPoint;
+double *hf_kin_build(const double *omega, const double *direction_deg, int n, double g, double depth, int stretching);
+HfKinPoint *hf_kin_point_new(int n);
+void hf_kin_point_delete(HfKinPoint *c);
+void hf_kin_at(const double *params, HfKinPoint *c, const double *p, double r, const double *x, double rho,
+               double *out);
+
 /* hydrostatics.c: params [C (36, row-major), position0 (3), yaw0, vertical0 (3)]: F = -C delta */
 void hf_hydrostatics(const double *params, const HfMotion *m, double *out);
 
