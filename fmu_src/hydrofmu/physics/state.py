@@ -67,6 +67,7 @@ class Env:
     current_speed: float = 0.0
     current_direction: float = 0.0
     profile: object = None
+    water: object = None   # physics.wave_kinematics.Water: the incident waves at this step (None: still water)
 
     @property
     def current(self):

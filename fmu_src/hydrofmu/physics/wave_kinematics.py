@@ -143,3 +143,23 @@ class WaveKinematics:
         dry = (z > eta) | (z < -self.depth)
         out[dry, :7] = 0.0
         return out
+
+
+class Water:
+    """The incident wave field the effects of one FMU see at its current step.
+
+    ``kinematics`` (WaveKinematics) and ``phasors`` (waves.Phasors, advanced by the FMU to the
+    step's time before its effects run), ρ [kg/m³].  ``at(x, y, z)`` → (8,) [u (3) m/s,
+    a (3) m/s², p_d Pa, η m] at a global point; ``wet(row, z)``: the point is below the
+    instantaneous surface (z ≤ η) and above the sea bed.
+    """
+
+    def __init__(self, kinematics: WaveKinematics, phasors, rho: float = 1025.0):
+        self.kinematics, self.phasors, self.rho = kinematics, phasors, float(rho)
+
+    def at(self, x: float, y: float, z: float) -> np.ndarray:
+        ph = self.phasors
+        return self.kinematics.at(ph.p, ph.ramp_factor, [(x, y, z)], self.rho)[0]
+
+    def wet(self, row, z: float) -> bool:
+        return -self.kinematics.depth <= z <= row[7]
