@@ -94,7 +94,12 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     """The model records of a built Python slave (fmi/fmu.h, fmi/models.c read them)."""
     recs = [("kind", [KINDS[type(desc)]]), ("start", slave.values.tolist())]
     if isinstance(desc, description.LoadFMU):
-        if getattr(desc, "waves", None) is not None:
+        waves = getattr(desc, "waves", None)
+        if waves is not None and (waves.kinematics or waves.points or waves.name is None):
+            raise InputError(desc.description, None, "waves", "the incident-wave kinematics (RIFLEX bodies, drags with "
+                             "waves = true, [waves.points]) have no compiled kernel in the FMU yet: build this "
+                             "scene with runtime = \"python\" ([build] runtime, or --runtime python)")
+        if waves is not None:
             recs += _waves(slave)
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]

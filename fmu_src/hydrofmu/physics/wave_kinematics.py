@@ -43,9 +43,7 @@ import math
 
 import numpy as np
 
-from .waves import Components, wave_number
-
-STRETCHING = ("none", "vertical", "wheeler", "extrapolation")
+from .waves import STRETCHING, Components, wave_number
 # the columns of ``WaveKinematics.at``'s rows
 COLUMNS = ("velocity[1]", "velocity[2]", "velocity[3]", "acceleration[1]", "acceleration[2]", "acceleration[3]",
            "pressure", "elevation")

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 SPECTRA = ("regular", "jonswap", "pierson_moskowitz")
+STRETCHING = ("none", "vertical", "wheeler", "extrapolation")   # wave_kinematics.py's options
 TAIL = 0.005           # share of the spectrum's energy the band leaves out (half on each side)
 MAX_OUTSIDE = 0.02     # largest share of the spectrum allowed outside the transfer functions' frequencies
 DIRECTION_TOL = 1e-6   # deg: a heading this close to a computed one is that one
@@ -63,7 +64,8 @@ class SeaState:
     spectrum: one of SPECTRA; regular waves: height H [m], period T [s], phase [deg];
     spectra: hs [m], tp [s], gamma (JONSWAP peak enhancement, ≥ 1); direction [deg, going to,
     counter-clockwise from +x]; spreading s (cos-2s, 0: long-crested); components N; seed;
-    ramp [s]; depth [m] (inf: deep water)."""
+    ramp [s]; depth [m] (inf: deep water); stretching: the kinematics above the mean water
+    level (physics/wave_kinematics.py)."""
     spectrum: str = "jonswap"
     hs: float = 0.0
     tp: float = 10.0
@@ -77,6 +79,7 @@ class SeaState:
     seed: int = 1
     ramp: float = 0.0
     depth: float = math.inf
+    stretching: str = "wheeler"   # the kinematics above the mean water level (wave_kinematics.STRETCHING)
 
     def check(self):
         """Raise WaveError naming the first bad knob."""
@@ -108,6 +111,8 @@ class SeaState:
             raise WaveError("depth", f"must be positive (inf: deep water), found {self.depth:g} m")
         if self.seed != int(self.seed) or self.seed < 0:
             raise WaveError("seed", f"must be a non-negative integer, found {self.seed:g}")
+        if self.stretching not in STRETCHING:
+            raise WaveError("stretching", f"expected one of {', '.join(STRETCHING)}, found {self.stretching!r}")
 
 
 def wave_number(omega, g=9.81, depth=math.inf):
