@@ -92,6 +92,14 @@ def body_waves(scene, body):
                    np.array(body.position[:2], float), kinematics, points)
 
 
+def joint_waves(scene):
+    """description.Waves of a CONB joint's connector FMU (its node feels the kinematics), or None."""
+    if scene.waves is None:
+        return None
+    sea = {k: v for k, v in vars(scene.waves).items() if k != "spectrum"}
+    return d.Waves(None, scene.waves.spectrum, sea, wave_window(scene), kinematics=True)
+
+
 def initial_motion(body):
     return Motion(np.array(body.position, float), np.array(body.attitude, float))
 
@@ -270,7 +278,7 @@ def _connector(scene, joint, exported, env):
                     f"{' '.join(map(str, joint.codes))}, scene {scene.name})",
         name=joint.name, accel_mode=joint.accel_mode, node=dict(joint.node),
         joint=joint_spring(scene, joint, exported), a=_pose(a), b=_pose(b) if b is not None else None,
-        environment=env)
+        environment=env, waves=joint_waves(scene))
     return Instance(joint.name, f"{scene.name}_{joint.name}", "joint", a.name, fmu, motion, forces)
 
 

@@ -219,6 +219,7 @@ class ConnectorFMU:
     a: Pose
     b: Pose | None
     environment: Environment
+    waves: Waves | None = None   # the scene's waves, for the node's drag and inertia (kinematics only)
 
 
 @dataclass

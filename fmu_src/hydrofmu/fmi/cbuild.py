@@ -117,6 +117,10 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
                 ev = side.coupling.model().memory[side.side]
                 recs.append((ev.C_TAG, ev.c_params()))
     elif isinstance(desc, description.ConnectorFMU):
+        if desc.waves is not None:
+            raise InputError(desc.description, None, "waves", "a CONB node in waves (its drag and inertia on the "
+                             "incident-wave kinematics) has no compiled kernel in the FMU yet: build this scene with "
+                             "runtime = \"python\" ([build] runtime, or --runtime python)")
         recs += [("sides", _motion(slave.side_a) + (_motion(slave.side_b) if slave.side_b else [-1] * 4)),
                  *_env(slave), ("explicit", [slave.explicit]),
                  ("joint", slave.joint.c_params()), ("node", slave.joint.node.c_params()),

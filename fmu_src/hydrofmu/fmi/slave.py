@@ -486,61 +486,7 @@ class ArraySlave(Fmi2Slave):
     def set_physics_state(self, state):
         pass
 
-
-class LoadSlave(ArraySlave):
-    """Loads on one floating body: motion in, force out (global axes, about the
-    reference point), one output group per effect plus the total."""
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        cfg = self.config
-        explicit = cfg.accel_mode == "explicit"
-        self.loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in cfg.effects], explicit)
-        Out, In = Fmi2Causality.output, Fmi2Causality.input
-        own_acc = explicit and (self.loads.uses_acceleration or any(c.own for c in cfg.couplings))
-        self.motion_inputs = self.add_motion("", cfg, own_acc)
-        inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
-        # hydrodynamic couplings: the source body's velocity (and acceleration) in
-        self.couplings = []
-        for c in cfg.couplings:
-            src = c.source
-            vel = self.motion_inputs[2] if c.own else self.add_vector(
-                f"{src}.velocity", 6, In, LIN_ROT["velocity"], c.velocity, f"velocity of coupled body {src}, global")
-            acc = None
-            if explicit:
-                acc = self.motion_inputs[3] if c.own else self.add_acceleration(
-                    f"{src}.acceleration", f"acceleration of coupled body {src}, global")
-            out = self.add_vector(f"{c.name}.force", 6, Out, LIN_ROT["force"], None,
-                                  f"hydrodynamic coupling {c.name} (from {src}'s motion)")
-            self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
-                                   "mass": c.mass})
-            inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
-        self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
-                                     "total load on the body, global axes, moments about the reference point")
-        self.effect_force = [self.add_vector(f"{e.name}.force", 6, Out, LIN_ROT["force"], None,
-                                             f"load of effect {e.name}")
-                             for e in self.loads.effects]
-        self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
-        self.inputs = inputs
-        wave_force = self._add_waves(cfg.waves)
-        self._wave_row = int(bool(wave_force))   # the output block's last row: the excitation
-        # every load output in one block: total, each effect, each coupling, the waves
-        self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
-                                     + wave_force)]
-        self._load_total = np.r_[0.0, np.ones(len(self.effect_force) + len(self.couplings) + len(wave_force))]
-        # export mode: the mass contribution of acceleration loads, for the dynamics side
-        if self.loads.uses_acceleration and not explicit:
-            self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
-                                                                                   np.array(self._start))))
-        if not explicit:
-            for c in self.couplings:
-                self.add_mass_export(f"{c['cfg'].name}.mass_matrix", c["mass"])
-        ne = len(self.loads.effects)   # (row k of the output block: see evaluate)
-        self._explicit = [(k, c["mass"], c["acceleration"]) for k, c in enumerate(self.couplings, 1 + ne)
-                          if c["acceleration"] is not None]
-        self.finish_registration()
-        self.memories = []   # set up by start_physics
-        self.stale = True
+    # the scene's waves (load and connector FMUs): the waves.* parameters, one Phasors a step
 
     def _add_waves(self, cfg):
         """The sea-state parameters waves.* (start values: the scene's), the excitation's
@@ -598,6 +544,62 @@ class LoadSlave(ArraySlave):
         except ValueError as exc:
             self.phasors = self.wave = self.water = self.kin = None
             raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
+
+
+class LoadSlave(ArraySlave):
+    """Loads on one floating body: motion in, force out (global axes, about the
+    reference point), one output group per effect plus the total."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        cfg = self.config
+        explicit = cfg.accel_mode == "explicit"
+        self.loads = BodyLoads([make_effect(e.type, e.name, e.data) for e in cfg.effects], explicit)
+        Out, In = Fmi2Causality.output, Fmi2Causality.input
+        own_acc = explicit and (self.loads.uses_acceleration or any(c.own for c in cfg.couplings))
+        self.motion_inputs = self.add_motion("", cfg, own_acc)
+        inputs = self.motion_inputs + self.add_environment(self.loads.uses_current)
+        # hydrodynamic couplings: the source body's velocity (and acceleration) in
+        self.couplings = []
+        for c in cfg.couplings:
+            src = c.source
+            vel = self.motion_inputs[2] if c.own else self.add_vector(
+                f"{src}.velocity", 6, In, LIN_ROT["velocity"], c.velocity, f"velocity of coupled body {src}, global")
+            acc = None
+            if explicit:
+                acc = self.motion_inputs[3] if c.own else self.add_acceleration(
+                    f"{src}.acceleration", f"acceleration of coupled body {src}, global")
+            out = self.add_vector(f"{c.name}.force", 6, Out, LIN_ROT["force"], None,
+                                  f"hydrodynamic coupling {c.name} (from {src}'s motion)")
+            self.couplings.append({"cfg": c, "velocity": vel, "acceleration": acc, "force": out,
+                                   "mass": c.mass})
+            inputs = inputs + [s_ for s_ in (vel, acc) if s_ is not None and s_ not in inputs]
+        self.force = self.add_vector("force", 6, Out, LIN_ROT["force"], None,
+                                     "total load on the body, global axes, moments about the reference point")
+        self.effect_force = [self.add_vector(f"{e.name}.force", 6, Out, LIN_ROT["force"], None,
+                                             f"load of effect {e.name}")
+                             for e in self.loads.effects]
+        self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
+        self.inputs = inputs
+        wave_force = self._add_waves(cfg.waves)
+        self._wave_row = int(bool(wave_force))   # the output block's last row: the excitation
+        # every load output in one block: total, each effect, each coupling, the waves
+        self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
+                                     + wave_force)]
+        self._load_total = np.r_[0.0, np.ones(len(self.effect_force) + len(self.couplings) + len(wave_force))]
+        # export mode: the mass contribution of acceleration loads, for the dynamics side
+        if self.loads.uses_acceleration and not explicit:
+            self.add_mass_export("mass_matrix", self.loads.mass_matrix(self.motion(self.motion_inputs,
+                                                                                   np.array(self._start))))
+        if not explicit:
+            for c in self.couplings:
+                self.add_mass_export(f"{c['cfg'].name}.mass_matrix", c["mass"])
+        ne = len(self.loads.effects)   # (row k of the output block: see evaluate)
+        self._explicit = [(k, c["mass"], c["acceleration"]) for k, c in enumerate(self.couplings, 1 + ne)
+                          if c["acceleration"] is not None]
+        self.finish_registration()
+        self.memories = []   # set up by start_physics
+        self.stale = True
 
     def start_physics(self):
         """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
@@ -823,6 +825,8 @@ class ConnectorSlave(ArraySlave):
         self.side_b = (self.add_motion("B.", cfg.b, False, "side B")
                        if cfg.b is not None else None)
         inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
+        self.motion_inputs = self.side_a
+        self._add_waves(cfg.waves)   # the node feels the waves (no outputs of their own)
         self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,
                                        "load on side A, global axes, about A's reference point")
         self.force_b = self.add_vector("B.force", 6, Out, LIN_ROT["force"], None,
@@ -843,9 +847,19 @@ class ConnectorSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
+        if self.wave_cfg is not None and self.phasors is None and self.running:
+            try:   # (initialization failed on the sea state: no step goes on without its waves)
+                self._start_waves()
+            except ValueError as exc:
+                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
+                return
+        env = self.env()
+        if self.phasors is not None:
+            self.phasors.at(self.next_time or 0.0)
+            env.water = self.water
         a = self.motion(self.side_a)
         b = self.motion(self.side_b) if self.side_b else None
-        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, self.env())
+        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, env)
         if self.joint.uses_acceleration:
             if self.explicit:
                 load_a = load_a - self.joint.mass_matrix(a).dot(a.acceleration)
@@ -853,6 +867,21 @@ class ConnectorSlave(ArraySlave):
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
         v[self.gap], v[self.rotation] = gap, rotation
+
+    def start_physics(self):
+        if self.wave_cfg is not None:
+            self._start_waves()
+        self.stale = True
+
+    def step_physics(self, t, dt):
+        self.stale = self.phasors is not None   # the node's wave loads move with time
+
+    def physics_state(self):
+        return {"waves": self.phasors is not None}
+
+    def set_physics_state(self, state):
+        if state and state.get("waves") and self.phasors is None:
+            self._start_waves()
 
 
 class FeedthroughMemory:
