@@ -2,6 +2,7 @@
 here (fixed and on-body points), a RIFLEX body's load in the FMU against the kernel at the same
 time, the scene's errors (file and key path), the compiled build's refusal."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -140,10 +141,44 @@ waves = true
     assert load_scene(path).bodies["barge"].effects[1].data["waves"] is True
 
 
-def test_compiled_build_refuses_kinematics_with_one_clear_error(tmp_path):
-    from hydrofmu.api import build
-    path = tmp_path / "s.toml"
-    path.write_text(SCENE.format(extra="") + '\n[build]\nruntime = "c"\n')
-    with pytest.raises(InputError, match="kinematics.*no compiled kernel.*runtime = \"python\""):
-        build(path, tmp_path / "out", log=lambda *_: None)
-    assert not (tmp_path / "out" / "s" / "manifest.json").exists()
+def joined_barges_in_waves(tmp, waves):
+    """models/joined_barges.toml (clump under barge A, CONB hitch, AQWA drag, DeepLines polar)
+    in a sea state ``waves`` (the [waves] table's lines), with named points, the polar of barge
+    B and an extra RELATIVE drag on it opting in to the waves."""
+    from conftest import MODELS
+    text = (MODELS / "joined_barges.toml").read_text().replace('"decks/', f'"{(MODELS / "decks").as_posix()}/')
+    polar_b = 'structure = "BARGE"\nsymmetry = "xz"\n\n[joints.hitch]'
+    assert polar_b in text
+    text = text.replace(polar_b, 'structure = "BARGE"\nsymmetry = "xz"\nwaves = true\n\n'
+                        '[[bodies.barge_b.effects]]\ntype = "aqwa_viscous_drag"\nname = "wave_drag"\n'
+                        'matrix = [3e4, 3e4, 6e4, 0.0, 0.0, 0.0]\noption = "RELATIVE"\nwaves = true\n\n[joints.hitch]')
+    text += "\n[waves]\n" + waves + """
+[waves.points.mooring]
+position = [20.0, 5.0, -10.0]
+
+[waves.points.stern]
+body = "barge_a"
+offset = [-40.0, 0.0, -8.0]
+"""
+    path = Path(tmp) / "jb_waves.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("waves, params", [
+    ('spectrum = "jonswap"\nhs = 3.0\ntp = 9.0\ncomponents = 60\nseed = 3\nramp = 10.0\nspreading = 4.0\n'
+     'depth = 60.0\nstretching = "wheeler"', {"waves.hs": 4.0, "waves.seed": 8}),
+    ('spectrum = "regular"\nheight = 3.0\nperiod = 8.0\ndirection = 200.0\nstretching = "extrapolation"',
+     {"waves.period": 9.0}),
+    ('spectrum = "pierson_moskowitz"\nhs = 2.0\ntp = 8.0\ncomponents = 40\nstretching = "vertical"', {}),
+])
+def test_compiled_kinematics_equal_the_python_flavour(tmp_path, waves, params):
+    """The joined barges in waves, compiled: every output of the load and connector FMUs (the
+    clump, the hitch's node, the polar and drag with waves = true, the named points) equal to
+    the Python flavour's to 1e-10 of its range, driven by the same moving inputs, with the sea
+    state changed through the waves.* parameters."""
+    from test_compiled import assert_equal_flavours
+    from hydrofmu.fmi.build import build_scene
+    scene = load_scene(joined_barges_in_waves(tmp_path, waves))
+    folder = build_scene(scene, tmp_path / "fmus", log=lambda *_: None, runtime="c")
+    assert assert_equal_flavours(folder, tmp_path, steps=400, dt=0.05, params=params, loads_only=True) <= 1e-10

@@ -494,6 +494,7 @@ class ArraySlave(Fmi2Slave):
         waves.<point>.velocity, acceleration, pressure, elevation; returns [the force slice] or []."""
         self.wave, self.wave_cfg, self.phasors, self.water, self.kin = None, cfg, None, None, None
         self.points = []
+        self.kin_wanted = cfg is not None and (cfg.kinematics or bool(cfg.points))
         if cfg is None:
             return []
         Par, Out = Fmi2Causality.parameter, Fmi2Causality.output

@@ -235,6 +235,6 @@ class CurrentPolar:
 
     def c_params(self):
         """current_polar.c's parameters: [n, xc, yc, zc, surfc, the closed table's angles
-        (n + 2), coefficients ((n + 2)·3) and slopes ((n + 1)·3)]."""
+        (n + 2), coefficients ((n + 2)·3), slopes ((n + 1)·3), waves (0/1)]."""
         return ([float(len(self.angles)), self.xc, self.yc, self.zc, self.surfc]
-                + self._a.tolist() + self._c.ravel().tolist() + self._slope.ravel().tolist())
+                + self._a.tolist() + self._c.ravel().tolist() + self._slope.ravel().tolist() + [float(self.waves)])

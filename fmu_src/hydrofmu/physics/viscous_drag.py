@@ -70,5 +70,5 @@ class ViscousDrag:
     C_TAG = "drag"   # its record in a compiled FMU (viscous_drag.c)
 
     def c_params(self):
-        """viscous_drag.c's parameters: [relative, matrix (36, row-major)]."""
-        return [float(self.relative)] + self.matrix.ravel().tolist()
+        """viscous_drag.c's parameters: [relative (0, 1; 2: RELATIVE with waves), matrix (36, row-major)]."""
+        return [float(self.relative) + float(self.waves)] + self.matrix.ravel().tolist()

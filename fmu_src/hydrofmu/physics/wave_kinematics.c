@@ -108,3 +108,8 @@ void hf_kin_at(const double *params, HfKinPoint *c, const double *p, double r, c
     out[0] = r * u0, out[1] = r * u1, out[2] = r * u2, out[3] = r * a0, out[4] = r * a1, out[5] = r * a2;
     out[6] = r * rho * g * pd;
 }
+
+int hf_water_at(const HfWater *w, const double *x, double *row) {
+    hf_kin_at(w->kin, w->cache, w->p, w->r, x, w->rho, row);
+    return x[2] <= row[7] && x[2] >= -w->depth;
+}

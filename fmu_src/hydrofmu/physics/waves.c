@@ -159,6 +159,7 @@ static double wrap360(double a) { return a - 360.0 * floor(a / 360.0); }
 static int transfer_init(Transfer *T, const double *p, double g, double depth) {
     T->x = p[2], T->y = p[3], T->closed = p[4] != 0.0, T->nw = (int)p[5], T->nb = (int)p[6];
     T->w = p + 7, T->d = T->w + T->nw;
+    if (T->nw == 0) return 0;   /* no excitation: the window alone */
     const double *re = T->d + T->nb, *im = re + 6 * T->nw * T->nb;
     T->local = malloc(sizeof(double) * 12 * T->nw * T->nb);
     if (!T->local) return -1;
@@ -211,6 +212,10 @@ static int transfer_at(const Transfer *T, double omega, double beta, double g, d
                        char *message, size_t size) {
     const double *w = T->w;
     int nw = T->nw;
+    if (nw == 0) {   /* no excitation */
+        memset(x, 0, sizeof(double) * 12);
+        return 0;
+    }
     if (omega < w[0] * (1 - 1e-9) || omega > w[nw - 1] * (1 + 1e-9)) {
         snprintf(message, size, "omega = %g rad/s is outside the transfer function's frequencies %g...%g rad/s",
                  omega, w[0], w[nw - 1]);
@@ -302,7 +307,7 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
     if (hf_sea_check(sea, field, m, size)) return NULL;
     const double lo_w = transfer[0], hi_w = transfer[1];
     int n = sea->spectrum == 0 ? 1 : (int)sea->components;
-    double *params = malloc(sizeof(double) * (2 + 3 * n + 14 * n)), *w = malloc(sizeof(double) * 4 * n);
+    double *params = malloc(sizeof(double) * (2 + 3 * n + 14 * n + n)), *w = malloc(sizeof(double) * 4 * n);
     double *amp = w + n, *beta = amp + n, *phase = beta + n;
     Spectrum *sp = NULL;
     Transfer T = {0};
@@ -360,6 +365,7 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
         ampl[2 * k] = amp[k] * cos(phase[k]), ampl[2 * k + 1] = amp[k] * sin(phase[k]);
         for (int q = 0; q < 6; q++) table[14 * k + q] = x[2 * q], table[14 * k + 7 + q] = -x[2 * q + 1];
         table[14 * k + 6] = cos(ph), table[14 * k + 13] = -sin(ph);
+        table[14 * n + k] = beta[k];
     }
     free(T.local), free(sp), free(w);
     return params;
