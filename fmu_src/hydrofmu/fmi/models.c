@@ -243,6 +243,29 @@ static int sea_advance(Instance *inst, Sea *S, double t) {
     return 0;
 }
 
+/* the FMU state's part of the waves: [n, the phasors' state (n values; 0: not drawn)] */
+static size_t sea_state_size(const Sea *S) {
+    return S->waves ? 1 + (S->phasors ? hf_phasors_state_size(S->phasors) : 0) : 0;
+}
+
+static void sea_save(const Sea *S, double *to) {
+    if (!S->waves) return;
+    to[0] = S->phasors ? (double)hf_phasors_state_size(S->phasors) : 0.0;
+    if (S->phasors) hf_phasors_save(S->phasors, to + 1);
+}
+
+/* from [from, end): the waves' part (drawn first from the restored waves.* values when this
+ * instance has not drawn them); the values it used, or -1 */
+static long sea_load(Instance *inst, Sea *S, const double *from, const double *end) {
+    if (!S->waves) return 0;
+    if (from >= end) return -1;
+    size_t n = (size_t)from[0];
+    if (from + 1 + n > end) return -1;
+    if (n == 0) return 1;
+    if (!S->wave && sea_draw(inst, S)) return -1;
+    return hf_phasors_load(S->phasors, from + 1, n) ? -1 : (long)(1 + n);
+}
+
 /* the named points' outputs [u (3), a (3), p_d, elevation] (LoadSlave.evaluate) */
 static void sea_points(Instance *inst, Sea *S, const HfMotion *m) {
     for (int k = 0; k < S->npoints; k++) {
@@ -430,7 +453,7 @@ static size_t load_state_size(const Instance *inst) {
     size_t n = 0;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) n += 1 + memory_size(&L->couplings[k].memory);
-    return n;
+    return n + sea_state_size(&L->sea);
 }
 
 static void load_save(const Instance *inst, double *to) {
@@ -443,6 +466,7 @@ static void load_save(const Instance *inst, double *to) {
         memory_save(m, to + 1);
         to += 1 + n;
     }
+    sea_save(&L->sea, to);
 }
 
 static int load_load(Instance *inst, const double *from, size_t size) {
@@ -456,7 +480,8 @@ static int load_load(Instance *inst, const double *from, size_t size) {
         if (from + 1 + n > end || n < 1 || memory_load(m, from + 1, n)) return -1;
         from += 1 + n;
     }
-    return from == end ? 0 : -1;
+    long used = sea_load(inst, &L->sea, from, end);
+    return used >= 0 && from + used == end ? 0 : -1;
 }
 
 const Model hf_load_model = {load_setup, load_start, load_evaluate, load_step, load_state_size, load_save, load_load,
@@ -536,8 +561,15 @@ static size_t no_state_size(const Instance *inst) { (void)inst; return 0; }
 static void no_save(const Instance *inst, double *to) { (void)inst, (void)to; }
 static int no_load(Instance *inst, const double *from, size_t n) { (void)inst, (void)from; return n == 0 ? 0 : -1; }
 
+static size_t connector_state_size(const Instance *inst) { return sea_state_size(&((const Connector *)inst->data)->sea); }
+static void connector_save(const Instance *inst, double *to) { sea_save(&((const Connector *)inst->data)->sea, to); }
+static int connector_load(Instance *inst, const double *from, size_t n) {
+    long used = sea_load(inst, &((Connector *)inst->data)->sea, from, from + n);
+    return used >= 0 && (size_t)used == n ? 0 : -1;
+}
+
 const Model hf_connector_model = {connector_setup, connector_start, connector_evaluate, connector_step,
-                                  no_state_size, no_save, no_load, connector_release};
+                                  connector_state_size, connector_save, connector_load, connector_release};
 
 /* -- dynamics FMU (DynamicsSlave over rigid.c) -------------------------------------------- */
 

@@ -672,11 +672,14 @@ class LoadSlave(ArraySlave):
         self.stale = bool(self.couplings) or self.phasors is not None  # memory and wave outputs move with time
 
     def physics_state(self):
-        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.phasors is not None}
+        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
 
     def set_physics_state(self, state):
         if state.get("waves") and self.phasors is None:   # taken after initialization, restored before it
             self._start_waves()
+        if state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
         saved = state["memory"]
         if len(saved) != len(self.memories):   # taken after initialization and restored before it, or back
             if saved:
@@ -878,11 +881,14 @@ class ConnectorSlave(ArraySlave):
         self.stale = self.phasors is not None   # the node's wave loads move with time
 
     def physics_state(self):
-        return {"waves": self.phasors is not None}
+        return {"waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
 
     def set_physics_state(self, state):
         if state and state.get("waves") and self.phasors is None:
             self._start_waves()
+        if state and state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
 
 
 class FeedthroughMemory:

@@ -105,6 +105,9 @@ HfPhasors *hf_phasors_new(const double *omega, const double *amp, int n, double 
 void hf_phasors_delete(HfPhasors *P);
 const double *hf_phasors_at(HfPhasors *P, double t);
 double hf_phasors_ramp(const HfPhasors *P);   /* r(t) at the phasors' time */
+size_t hf_phasors_state_size(const HfPhasors *P);
+void hf_phasors_save(const HfPhasors *P, double *to);
+int hf_phasors_load(HfPhasors *P, const double *from, size_t n);
 /* the phasors of hf_wave_build's parameters (which they point into) */
 HfPhasors *hf_wave_phasors(const double *params);
 /* out: [F (6), elevation] at time t (advances P to t) */

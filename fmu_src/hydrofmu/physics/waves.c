@@ -434,6 +434,24 @@ const double *hf_phasors_at(HfPhasors *P, double t) {
     return P->p;
 }
 
+/* the phasors' state (an FMU state holds it: a run restored continues bit for bit):
+ * [t, sync, j, h, has_rot, p (2n)]; the rotation is recomputed from h */
+size_t hf_phasors_state_size(const HfPhasors *P) { return 5 + 2 * (size_t)P->n; }
+
+void hf_phasors_save(const HfPhasors *P, double *to) {
+    to[0] = P->t, to[1] = P->sync, to[2] = P->j, to[3] = P->h, to[4] = P->has_rot;
+    memcpy(to + 5, P->p, sizeof(double) * 2 * P->n);
+}
+
+int hf_phasors_load(HfPhasors *P, const double *from, size_t n) {
+    if (n != hf_phasors_state_size(P) || !(from[2] >= 0 && from[2] <= P->resync)) return -1;
+    P->t = from[0], P->sync = from[1], P->j = (int)from[2], P->h = from[3], P->has_rot = from[4] != 0.0;
+    memcpy(P->p, from + 5, sizeof(double) * 2 * P->n);
+    if (P->has_rot)
+        for (int k = 0; k < P->n; k++) P->rot[2 * k] = cos(P->omega[k] * P->h), P->rot[2 * k + 1] = sin(P->omega[k] * P->h);
+    return 0;
+}
+
 double hf_phasors_ramp(const HfPhasors *P) {
     double t = P->t, length = P->ramp;
     if (!(t < length)) return 1.0;

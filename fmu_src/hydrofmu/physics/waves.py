@@ -401,6 +401,16 @@ class Phasors:
             self._h = h
         return self.p
 
+    def state(self) -> dict:
+        """The phasors' state (an FMU state holds it: a restored run continues bit for bit)."""
+        return {"t": self.t, "sync": self._sync, "j": self._j, "h": self._h, "rot": self._rot is not None,
+                "p": self.p.view(float).tolist()}
+
+    def set_state(self, state: dict):
+        self.t, self._sync, self._j, self._h = state["t"], state["sync"], state["j"], state["h"]
+        self.p.view(float)[:] = state["p"]
+        self._rot = np.exp(1j * (self.omega * self._h)) if state["rot"] else None
+
     @property
     def ramp_factor(self) -> float:
         """r(t) at the phasors' time."""
