@@ -173,3 +173,54 @@ def lines(table):
                    + ", ".join(f"{x['kin_wheeler_x_waves']:.2f}×" for x in r)
                    + f" (at {', '.join(str(x['components']) for x in r)} components)")
     return out
+
+
+# -- the joined barges in a sea state: the clump's load with and without waves ------------------
+
+JOINED_WAVES = """
+[waves]
+spectrum = "jonswap"
+hs = 3.0
+tp = 9.0
+direction = 10.0
+components = 200
+seed = 4
+ramp = 20.0
+"""
+
+
+def joined_barges_clump(out, stop=300.0, waves=JOINED_WAVES):
+    """models/joined_barges.toml (its clump 8 m under barge A's stern, in a 1 m/s current) run
+    by our master in-process, without and with ``waves``: {label: Result}."""
+    from ..cosim import inprocess, master
+    from ..scene import load_scene
+    models = Path(__file__).resolve().parents[3] / "models"
+    text = (models / "joined_barges.toml").read_text().replace('"decks/', f'"{(models / "decks").as_posix()}/')
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    results = {}
+    for label, extra in (("current only", ""), ("current and waves", waves)):
+        path = out / f"joined_barges_{'waves' if extra else 'calm'}.toml"
+        path.write_text(text + extra)
+        results[label] = master.run(inprocess.system(load_scene(path)), stop=stop, progress=False)
+    return results
+
+
+def plot_clump(results, path):
+    """The clump's load (surge and heave force, on barge A) without and with waves."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
+    for label, r in results.items():
+        t = np.asarray(r.time)
+        for ax, k, name in zip(axes, (1, 3), ("surge force", "heave force")):
+            ax.plot(t, np.asarray(r[f"barge_a.clump.force[{k}]"]) / 1e3, lw=0.8, label=label)
+            ax.set_ylabel(f"clump {name} [kN]")
+    axes[0].legend(loc="upper right")
+    axes[1].set_xlabel("time [s]")
+    axes[0].set_title("joined barges: the clump 8 m under barge A's stern (JONSWAP Hs 3 m, Tp 9 s; 1 m/s current)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
