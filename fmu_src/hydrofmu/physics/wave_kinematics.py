@@ -68,8 +68,17 @@ class WaveKinematics:
         self.cos, self.sin = np.cos(b), np.sin(b)
         self.g, self.depth = float(g), float(depth)
         self.w2 = self.omega ** 2
-        self.wc, self.ws = self.omega * self.cos, self.omega * self.sin
-        self.w2c, self.w2s = self.w2 * self.cos, self.w2 * self.sin
+        # every output as one product: [F_h·E, F_v·E, F_p·E, E] (E as interleaved (re, im) floats,
+        # each factor repeated for re and im) times this (8N × 8) weight matrix
+        n = self.omega.size
+        w = np.zeros((8 * n, 8))
+        re, im = np.arange(0, 2 * n, 2), np.arange(1, 2 * n, 2)
+        w[re, 0], w[re, 1] = self.omega * self.cos, self.omega * self.sin          # u_h: ω F_h Re E
+        w[im, 3], w[im, 4] = -self.w2 * self.cos, -self.w2 * self.sin              # a_h: −ω² F_h Im E
+        w[2 * n + im, 2], w[2 * n + re, 5] = self.omega, self.w2                   # w, a_z: F_v
+        w[4 * n + re, 6] = 1.0                                                    # p_d / ρg: F_p Re E
+        w[6 * n + re, 7] = 1.0                                                    # η
+        self.weights = w
         if math.isinf(depth):
             self.coth = self.tanh = np.ones_like(self.k)
         else:
@@ -107,40 +116,36 @@ class WaveKinematics:
         pts = np.atleast_2d(np.asarray(points, dtype=float))
         z = pts[:, 2]
         if self._where is not None and np.array_equal(self._where[0], pts):
-            _, h, fixed = self._where
+            _, h, stacked = self._where
         else:
-            h, fixed = self.horizontal(pts), None
-        e = h * (r * p)[None, :]                 # E_k, (P, N)
-        re, im = e.real, e.imag
-        eta = re.sum(axis=1)
-        if self.stretching == "wheeler":
-            if math.isinf(self.depth):
-                zs = z - eta
-            else:
-                zs = self.depth * (z - eta) / (self.depth + eta)
-            fh, fv, fp = self.factors(np.minimum(zs, 0.0))
-        else:
-            if fixed is None:
-                below = z <= 0
-                fh, fv, fp = (np.empty((z.size, self.k.size)) for _ in range(3))
-                if below.any():
-                    fh[below], fv[below], fp[below] = self.factors(z[below])
-                if (~below).any():
-                    fh[~below], fv[~below], fp[~below] = self._above(z[~below])
-                fixed = (fh, fv, fp)
-            fh, fv, fp = fixed
-        self._where = (pts.copy(), h, fixed if self.stretching != "wheeler" else None)
-        a, b = fh * re, fh * im
-        out = np.empty((z.size, 8))
-        out[:, 0], out[:, 1] = a.dot(self.wc), a.dot(self.ws)
-        out[:, 2] = (fv * im).dot(self.omega)
-        out[:, 3], out[:, 4] = -b.dot(self.w2c), -b.dot(self.w2s)
-        out[:, 5] = (fv * re).dot(self.w2)
-        out[:, 6] = rho * self.g * (fp * re).sum(axis=1)
+            h, stacked = self.horizontal(pts), None
+        e = h * (r * p)                          # E_k, (P, N)
+        eta = e.real.sum(axis=1)
+        if self.stretching == "wheeler":         # the factors move with η
+            zs = z - eta if math.isinf(self.depth) else self.depth * (z - eta) / (self.depth + eta)
+            stacked = self._stack(*self.factors(np.minimum(zs, 0.0)))
+        elif stacked is None:
+            below = z <= 0
+            fh, fv, fp = (np.empty((z.size, self.k.size)) for _ in range(3))
+            if below.any():
+                fh[below], fv[below], fp[below] = self.factors(z[below])
+            if (~below).any():
+                fh[~below], fv[~below], fp[~below] = self._above(z[~below])
+            stacked = self._stack(fh, fv, fp)
+        self._where = (pts.copy(), h, stacked if self.stretching != "wheeler" else None)
+        ev = e.view(float)                       # (P, 2N) interleaved (re, im)
+        out = (stacked * ev[:, None, :]).reshape(ev.shape[0], -1).dot(self.weights)
+        out[:, 6] *= rho * self.g
         out[:, 7] = eta
         dry = (z > eta) | (z < -self.depth)
         out[dry, :7] = 0.0
         return out
+
+    @staticmethod
+    def _stack(fh, fv, fp):
+        """[F_h, F_v, F_p, 1], each repeated for (re, im): (P, 4, 2N)."""
+        return np.stack((np.repeat(fh, 2, axis=1), np.repeat(fv, 2, axis=1), np.repeat(fp, 2, axis=1),
+                         np.ones((fh.shape[0], 2 * fh.shape[1]))), axis=1)
 
 
 class Water:
