@@ -110,7 +110,8 @@ def _library():
 
 
 def compiled_costs(counts=COUNTS, steps=20000, rounds=5):
-    """{n: {name: seconds per step}} of the C kernels, the median of ``rounds``."""
+    """{n: {name: seconds per step}} of the C kernels, the best of ``rounds`` (each a tight C loop
+    of ``steps`` steps: on a shared machine the least disturbed round is the kernel's cost)."""
     from ..physics.waves import STRETCHING
     lib = _library()
     D, P = ctypes.c_double, ctypes.POINTER(ctypes.c_double)
@@ -136,7 +137,7 @@ def compiled_costs(counts=COUNTS, steps=20000, rounds=5):
         for _ in range(rounds):
             for k, f in runs.items():
                 times[k].append(f() / steps)
-        out[n] = {k: float(np.median(v)) for k, v in times.items()}
+        out[n] = {k: float(np.min(v)) for k, v in times.items()}
         for p in kin.values():
             ctypes.CDLL(None).free(p)
     return out

@@ -466,13 +466,12 @@ HfPhasors *hf_wave_phasors(const double *params) {
 void hf_waves(const double *params, HfPhasors *P, double t, double *out) {
     int n = (int)params[0];
     const double *table = params + 2 + 3 * n, *p = hf_phasors_at(P, t);
-    memset(out, 0, sizeof(double) * 7);
+    double acc[7] = {0};   /* (local sums: out may alias, these stay in registers) */
     for (int k = 0; k < n; k++) {
         double re = p[2 * k], im = p[2 * k + 1];
         const double *a = table + 14 * k, *b = a + 7;
-        for (int j = 0; j < 7; j++) out[j] += re * a[j] + im * b[j];
+        for (int j = 0; j < 7; j++) acc[j] += re * a[j] + im * b[j];
     }
     double r = hf_phasors_ramp(P);
-    if (r != 1.0)
-        for (int j = 0; j < 7; j++) out[j] *= r;
+    for (int j = 0; j < 7; j++) out[j] = r * acc[j];
 }
