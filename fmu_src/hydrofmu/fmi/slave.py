@@ -539,9 +539,10 @@ class ArraySlave(Fmi2Slave):
             transfer = cfg.transfer(g, sea.depth)
             self.wave = None if transfer is None else WaveLoad(comps, transfer, cfg.position, sea.ramp, g, sea.depth,
                                                                phasors=self.phasors)
-            if cfg.kinematics or self.points:
-                self.kin = WaveKinematics(comps, g, sea.depth, sea.stretching)
-                self.water = Water(self.kin, self.phasors, float(self.values[self.rho])) if cfg.kinematics else None
+            # the points and the effects each their own kernel: each keeps the factors of its last points
+            self.kin = WaveKinematics(comps, g, sea.depth, sea.stretching) if self.points else None
+            self.water = (Water(WaveKinematics(comps, g, sea.depth, sea.stretching), self.phasors,
+                                float(self.values[self.rho])) if cfg.kinematics else None)
         except ValueError as exc:
             self.phasors = self.wave = self.water = self.kin = None
             raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
