@@ -40,6 +40,7 @@ height = 2.0
 period = 8.0
 direction = 30.0
 phase = 20.0
+ramp = 0.0
 {extra}
 
 [waves.points.fixed]

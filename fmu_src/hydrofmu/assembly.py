@@ -301,10 +301,16 @@ def fit_memories(couplings):
     """Realise every state-space coupling's kernels once and store the fits in the coupling
     (``HydroCoupling.fits``, carried by the FMU descriptions that hold it): instantiation
     then only loads them.  The build calls this, not ``assemble``: a batch assembles every
-    case to tell its variants apart and must not pay the fits for it."""
+    case to tell its variants apart and must not pay the fits for it.  A coupling whose
+    realisation misses its tolerance (``physics.coupling.Coupling.fallback``, warned once
+    there) is stored as a convolution: the FMUs step what the build reported."""
     for c in couplings:
         if c.method == "state_space" and c.kernels and not c.fits:
-            c.fits = [d.Fit(i, j, f.A, f.B, f.C, f.error) for (i, j), f in sorted(c.model().fits.items())]
+            model = c.model()
+            if model.method == "convolution":
+                c.method = "convolution"
+                continue
+            c.fits = [d.Fit(i, j, f.A, f.B, f.C, f.error) for (i, j), f in sorted(model.fits.items())]
 
 
 def notes(scene, system):

@@ -43,6 +43,7 @@ import numpy as np
 from .errors import InputError, InputWarning
 from . import keys as file_keys
 from .names import did_you_mean, unknown
+from .physics.rigid_body import LINEAR_RANGE
 from .cosim.manifest import read_manifest
 from .textfile import read_toml
 from .writable import check_folder
@@ -133,6 +134,32 @@ def _knobs(p, table, where, seen=None):
     return out
 
 
+def _kind(value):
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    return "a string" if isinstance(value, str) else "an array" if isinstance(value, list) else "a table"
+
+
+def _one_kind(p, where, key, values):
+    """The values of one knob: one kind (the table's column holds one type: a string among
+    numbers ended the batch after every case had run), and numbers where the knob is an FMU
+    parameter (``instance.variable``, or a scene key the FMUs expose as one).  Recorded in
+    ``p`` naming the key and the value, before any case runs."""
+    first = key.split(".", 1)[0].split("[", 1)[0]
+    real = key in EXPOSED or (first not in SCENE_SECTIONS and "." in key and not key.startswith("run."))
+    for value in values:
+        if real and _kind(value) != "a number":   # NaN passes: the case fails, the others run
+            p.add(where, f"value {value!r} is not a number: {key} is a real parameter of the FMUs")
+            return
+    kinds = [_kind(v) for v in values]
+    odd = next((k for k, kind in enumerate(kinds) if kind != kinds[0]), None)
+    if odd is not None:
+        p.add(where, f"value {values[odd]!r} is {kinds[odd]} among {kinds[0].split()[1]}s ({values[0]!r}, …): every case's "
+                     "value of a knob is one kind (the table's column)")
+
+
 def load_cases(source, base=None) -> Batch:
     """Read and check a case file (path) or the same content as a dict (paths in it relative
     to ``base``, default the current folder).  Raises one InputError naming every problem."""
@@ -178,6 +205,7 @@ def load_cases(source, base=None) -> Batch:
         again = next((v for k, v in enumerate(values) if v in values[:k]), None)
         if again is not None:
             p.add(f"matrix.{key}", f"value {again!r} given twice (two cases would be one)")
+        _one_kind(p, f"matrix.{key}", key, values)
         matrix[key] = values
     extra = doc.get("cases", [])
     if not isinstance(extra, list) or not all(isinstance(c, dict) for c in extra):
@@ -185,6 +213,9 @@ def load_cases(source, base=None) -> Batch:
         extra = []
     # a single case may override a shared knob (its own value), not give one twice itself
     extra = [_knobs(p, c, f"cases[{i}]") for i, c in enumerate(extra)]
+    for where, knobs in [("set", fixed)] + [(f"cases[{i}]", c) for i, c in enumerate(extra)]:
+        for key, value in knobs.items():
+            _one_kind(p, f"{where}.{key}", key, [value])
     # the algorithm is one knob wherever it is written: checked the same in every table
     for where, value in ([("set.run.algorithm", fixed.get("run.algorithm"))]
                          + [("matrix.run.algorithm", v) for v in matrix.get("run.algorithm", [])]
@@ -288,6 +319,9 @@ def _check_scene_keys(batch, first):
     try:
         load_scene(batch.scene, first)
     except InputError as exc:
+        if exc.field in first:      # the knob's own value is refused by the scene: every case would be
+            raise InputError(batch.path, None, exc.field, f"value {first[exc.field]!r}: "
+                                                          f"{exc.message.split('; ')[0]}") from None
         for key in first:
             if key in getattr(exc, "unknown", {}):
                 parent = key.rsplit(".", 1)[0]
@@ -484,22 +518,52 @@ def statistics(time_, values, outputs, transient=0.0):
     return out
 
 
+# the cases' linear_range column: false past the dynamics partner's linear range (15°)
+LINEAR_RANGE_DEG = math.degrees(LINEAR_RANGE)
+
+
+def _tilt_columns(folder):
+    """The roll and pitch columns of every body of a built scene (its manifest's dynamics)."""
+    from .cosim.manifest import read_manifest
+    return [f"{inst}.{prefix}attitude[{k}]" for inst, prefix in read_manifest(folder)["dynamics"].values()
+            for k in (1, 2)]
+
+
+def _max_tilt(columns, values, tilt):
+    """The largest |roll| or |pitch| [deg] over the run, of the ``tilt`` columns recorded."""
+    cols = [columns.index(c) for c in tilt if c in columns]
+    return float(np.degrees(np.nanmax(np.abs(values[:, cols])))) if cols and len(values) else 0.0
+
+
 def run_case(task, blob):
     """Run one case on a worker; never raises for a failing case (status 'failed', error)."""
     from .cosim.master import run
     with _LOCK:
         t0 = time.perf_counter()
-        out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None}
+        out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None,
+               "linear_range": None, "max_tilt_deg": None}
+        tilt = []
         try:
             folder = _materialize(blob)
+            tilt = _tilt_columns(folder)
+            record = list(task["outputs"]) + [c for c in tilt if c not in task["outputs"]]
             t0 = time.perf_counter()
-            result = run(folder, record=task["outputs"], parameters=task["parameters"], progress=False,
-                         **task["run"])
+            result = run(folder, record=record, parameters=task["parameters"], progress=False, **task["run"])
         except Exception as exc:   # a failing case is reported, the batch goes on
-            out.update(status="failed", error=f"{type(exc).__name__}: {exc}", wall_s=time.perf_counter() - t0)
+            text = str(exc)
+            # capsized (the dynamics partner's word): said first, not as an exception's class
+            error = f"capsized{text.split('capsized', 1)[1]} ({text.split(':', 1)[0]})" if "capsized:" in text \
+                else f"{type(exc).__name__}: {text}"
+            out.update(status="failed", error=error, wall_s=time.perf_counter() - t0)
+            partial = getattr(exc, "partial", None)
+            if "capsized:" in text:
+                out.update(linear_range=False, max_tilt_deg=90.0 if partial is None else
+                           max(90.0, _max_tilt(partial.columns, partial.values, tilt)))
             return out
         out["wall_s"] = time.perf_counter() - t0
-        values = result.values
+        worst = _max_tilt(record, result.values, tilt)
+        out.update(max_tilt_deg=worst, linear_range=bool(worst <= LINEAR_RANGE_DEG))
+        values = result.values[:, :len(task["outputs"])]
         bad = ~np.isfinite(values)
         if bad.any():
             k, j = np.argwhere(bad)[0]
@@ -674,6 +738,7 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
     def record(cid, knobs, variant, result):
         row = {"case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
                "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
+               "linear_range": result.get("linear_range"), "max_tilt_deg": result.get("max_tilt_deg"),
                "worker": result.get("worker")}
         try:
             (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
@@ -777,9 +842,10 @@ def assemble_table(out, ids, batch, units=None, kept=None, log=print):
     for cid in ids:
         r = (kept or {}).get(cid) or json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
         rows.append({**{k: _cell(v) for k, v in r["knobs"].items()}, "status": r["status"], "wall_s": r["wall_s"],
+                     "linear_range": r.get("linear_range"), "max_tilt_deg": r.get("max_tilt_deg"),
                      **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
     stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
-    columns = batch.keys + ["status", "wall_s"] + stats + ["error", "case", "build"]
+    columns = batch.keys + ["status", "wall_s", "linear_range", "max_tilt_deg"] + stats + ["error", "case", "build"]
     table = pd.DataFrame(rows, columns=columns)
     written = {}
     for name, write in (("cases.csv", lambda p: table.to_csv(p, index=False)),

@@ -127,6 +127,9 @@ EFFECTS = {
     },
 }
 
+PERIOD_VARIABLE = (enum("period", "omega", "wavenumber", "hz"),
+                   "WAMIT: the first column of the file, as the run's IPEROUT wrote it: period [s] (default), "
+                   "omega [rad/s], wavenumber (KL = ω²L/g), hz [Hz]")
 BEM_EFFECT = {
     "bem": (STRING, "Capytaine dataset (.nc), or WAMIT file, relative to the scene"),
     "body": (STRING, "BEM body (optional for a one-body file; WAMIT: body1, body2, …)"),
@@ -134,7 +137,8 @@ BEM_EFFECT = {
 }
 # effects whose data always come from a BEM result: no deck variant (an empty one never matches)
 EFFECTS["wave_excitation"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "excitation: Capytaine dataset "
-                                                                                  "(.nc) or WAMIT .3 / .2")}}
+                                                                                  "(.nc) or WAMIT .3 / .2"),
+                                                     "period_variable": PERIOD_VARIABLE}}
 EFFECTS["bem_hydrostatics"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "hydrostatics: Capytaine dataset "
                                                                                    "(.nc) or WAMIT .hst")}}
 
@@ -150,7 +154,7 @@ WAVES = {
     "spreading": (NONNEG, "cos-2s spreading exponent s (0: long-crested)"),
     "components": ({"type": "integer", "minimum": 1}, "number of wave components (default 200)"),
     "seed": ({"type": "integer", "minimum": 0}, "random seed of frequencies, phases, directions"),
-    "ramp": (NONNEG, "length of the smooth start ramp [s]"),
+    "ramp": (NONNEG, "length of the smooth start ramp [s] (default: 3 peak periods; 0: none)"),
     "depth": (POSITIVE, "water depth [m] (default: deep water)"),
     "stretching": (enum("none", "vertical", "wheeler", "extrapolation"),
                    "wave kinematics above the mean water level (default wheeler)"),
@@ -212,6 +216,7 @@ BEM_COUPLING = {
     "name": (NAME, "prefix of the couplings' names (default \"bem\")"),
     "dofs": (NAMES, "dofs to keep, e.g. [\"Surge\", \"Heave\", \"Pitch\"] (default: all)"),
     "ulen": (POSITIVE, "WAMIT: the length ULEN [m]"),
+    "period_variable": PERIOD_VARIABLE,
     "timdel": (POSITIVE, "kernel spacing [s] (default from the grid)"),
     "kernel_length": (POSITIVE, "kernel length [s] (default from the grid)"),
     "symmetry_tolerance": (POSITIVE, "A∞ asymmetry allowed, relative to √(A_ii·A_jj)"),

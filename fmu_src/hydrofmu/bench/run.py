@@ -14,6 +14,8 @@ Parts (each also callable alone, see ``PARTS``):
 - startup: load, instantiate and initialise (and free) every scene of models/ again in a
   running process, against the pythonfmu floor (``startup``)
 - stability: added-mass stability map, explicit against export (``stability``)
+- hold: the load hold against light damping: free decays against Δζ of ``physics.hold``,
+  every scene of models/ and the cylinder in a sea with each hold and step (``hold``)
 - bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 - robust: time to report one bad number near the end of a 50 MB deck against reading it
   good; memory over fmi2Instantiate/fmi2FreeInstance cycles with and without the shim's
@@ -47,7 +49,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from . import compiled, cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust  # noqa: E402
-from . import stability, startup  # noqa: E402
+from . import hold, stability, startup  # noqa: E402
 from . import waves_cost  # noqa: E402
 from .timing import over  # noqa: E402
 
@@ -435,6 +437,14 @@ def part_stability(out, quick):
     return [f"added-mass map: {csv_path.name}, {png.name}"]
 
 
+def part_hold(out, quick):
+    d = hold.decay(out, steps=(0.1,) if quick else (0.05, 0.1, 0.2))
+    write_csv(out / "hold_decay.csv", d)
+    s = hold.scenes(out, stop=60.0 if quick else 600.0, factors=(1,) if quick else (1, 2))
+    write_csv(out / "hold_scenes.csv", s)
+    return hold.summary(d, s)
+
+
 def part_bem(out, quick):
     sizes = ((12, 50), (12, 100)) if quick else ((12, 50), (12, 100), (12, 200), (24, 100))
     rows = radiation_cost.measure(sizes, rounds=2 if quick else 5)
@@ -581,6 +591,7 @@ def waves_lines(rows):
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "startup": part_startup, "stability": part_stability,
+         "hold": part_hold,
          "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves,
          "kinematics": part_kinematics}
 

@@ -129,7 +129,7 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
                  ("joint", slave.joint.c_params()), ("node", slave.joint.node.c_params()),
                  ("outputs", [slave.force_a.start, slave.force_b.start, slave.gap.start, slave.rotation.start])]
     else:
-        from ..physics.rigid_body import GIMBAL_TOL
+        from ..physics.rigid_body import CAPSIZE, GIMBAL_TOL, LINEAR_RANGE
         for part in slave.parts:
             b = part["cfg"]
             recs.append(("body", [b.mass, *np.ravel(b.inertia), *np.ravel(b.cog), *np.ravel(b.stiffness),
@@ -137,7 +137,7 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
                          + [part[k].start for k in ("position", "attitude", "velocity", "acceleration", "added")]
                          + [len(part["loads"])] + [s.start for s in part["loads"]]))
         recs += [("cross", [i, j, s.start]) for (i, j), s in slave.cross.items()]
-        recs.append(("dynamics", [desc.substep, desc.load_hold == "linear", GIMBAL_TOL]))
+        recs.append(("dynamics", [desc.substep, desc.load_hold == "linear", GIMBAL_TOL, LINEAR_RANGE, CAPSIZE]))
     return recs
 
 

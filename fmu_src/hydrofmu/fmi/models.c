@@ -581,7 +581,7 @@ typedef struct {
 
 typedef struct {
     int n, ncross, linear;
-    double substep, gimbal_tol;
+    double substep, gimbal_tol, linear_range, capsize, watch;   /* rigid_body.LINEAR_RANGE, CAPSIZE [rad] */
     Body *bodies;
     int (*cross)[3];      /* target, source, value reference of the 6x6 block */
     double *model, *work, *y, *saved, *acc, *load, *rate, *last, *table;
@@ -603,8 +603,9 @@ static int dynamics_setup(Instance *inst) {
     Dynamics *D = calloc(1, sizeof(Dynamics));
     inst->data = D;
     const Record *d = hf_record(inst, "dynamics", NULL);
-    if (!D || !d || d->n != 3) goto bad;
+    if (!D || !d || d->n != 5) goto bad;
     D->substep = d->v[0], D->linear = d->v[1] != 0.0, D->gimbal_tol = d->v[2];
+    D->linear_range = d->v[3], D->capsize = d->v[4], D->watch = D->linear_range;
     int from = 0;
     while (hf_record(inst, "body", &from)) D->n++;
     from = 0;
@@ -741,8 +742,31 @@ static const double RK6_A[49] = {0, 0, 0, 0, 0, 0, 0,
 static const double RK6_B[7] = {11.0 / 120, 0, 27.0 / 40, 27.0 / 40, -4.0 / 15, -4.0 / 15, 11.0 / 120};
 static const double RK6_C[7] = {0, 1.0 / 3, 2.0 / 3, 1.0 / 3, 1.0 / 2, 1.0 / 2, 1};
 
+/* slave.DynamicsSlave._watch_range: past the linear range one warning per run, past the
+ * capsize angle the step fails */
+static void watch_range(Instance *inst, Dynamics *D, double t) {
+    int worst = -1;
+    double big = D->watch;
+    for (int i = 0; i < D->n; i++)
+        for (int k = 3; k < 5; k++)
+            if (fabs(D->y[12 * i + k]) > big) big = fabs(D->y[12 * i + k]), worst = 12 * i + k;
+    if (worst < 0) return;
+    int k = worst % 12;
+    const char *var = inst->names[D->bodies[worst / 12].attitude + k - 3], *which = k == 3 ? "roll" : "pitch";
+    double deg = D->y[worst] * 57.29577951308232;
+    if (big > D->capsize) {
+        hf_set_error(inst, "capsized: %s (%s) = %.1f deg at t = %g s: |roll| or |pitch| past %g deg, far outside "
+                           "the linear hydrostatics and first-order wave loads", var, which, deg, t,
+                     D->capsize * 57.29577951308232);
+        return;
+    }
+    hf_warn(inst, "left the linear range: %s (%s) = %.1f deg at t = %g s, past %g deg: the hydrostatics and "
+                  "first-order wave loads assume small angles (said once per run)", var, which, deg, t,
+            D->linear_range * 57.29577951308232);
+    D->watch = D->capsize;
+}
+
 static void dynamics_step(Instance *inst, double t, double dt) {
-    (void)t;
     Dynamics *D = inst->data;
     int N = 6 * D->n;
     /* (fmu.c has checked the inputs before the step) */
@@ -769,12 +793,13 @@ static void dynamics_step(Instance *inst, double t, double dt) {
     int status = hf_rigid_steps(D->model, tab, steps, D->load, rate, D->y, D->acc, D->work);
     if (status != 0) {   /* the state stays at the step's start */
         memcpy(D->y, D->saved, sizeof(double) * 2 * N);
-        hf_set_error(inst, status == 1 ? "GimbalLockError: pitch reached +-90 degrees: the ZYX Euler-angle rates are "
+        hf_set_error(inst, status == 1 ? "capsized: pitch reached +-90 degrees: the ZYX Euler-angle rates are "
                                          "singular there; the rigid body cannot go on"
                                        : "the rigid-body step is not finite (a singular mass matrix or non-finite loads)");
         return;
     }
     publish(inst, D);
+    watch_range(inst, D, t + dt);
 }
 
 /* [y (12n), has_last, last_dt, last (6n)] */

@@ -67,7 +67,7 @@ from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
 from ..physics.memory import StateSpace
-from ..physics.rigid_body import CoupledBodies, RigidBody
+from ..physics.rigid_body import CAPSIZE, LINEAR_RANGE, CoupledBodies, GimbalLockError, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
 from ..physics.waves import Phasors, WaveLoad, components as wave_components
@@ -742,6 +742,11 @@ class DynamicsSlave(ArraySlave):
         self.finish_registration()
         self.solver = None
         self.last_loads = None   # (summed loads, step) of the last step: the linear hold's slope
+        # roll and pitch of every body in the motion outputs (12 per body: position, attitude,
+        # velocity), the attitude variables they are, and the angle watched (LINEAR_RANGE until said)
+        self._tilt = np.array([12 * i + k for i in range(len(self.parts)) for k in (3, 4)])
+        self._tilt_vrs = [part["attitude"].start + k for part in self.parts for k in (0, 1)]
+        self._watch = LINEAR_RANGE
         self.stale = False
 
     def start_physics(self):
@@ -787,14 +792,35 @@ class DynamicsSlave(ArraySlave):
             last = self.last_loads
             rates = loads * 0.0 if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
-        if self.solver is not None:   # the group's state is one vector already
-            acc = self.solver.step(dt, loads, rates).ravel()
-            out = np.concatenate((self.solver.y, acc))
-        else:
-            acc = self.bodies[0].step(dt, loads, rates)
-            out = np.concatenate((self.bodies[0]._y, acc))
+        try:
+            if self.solver is not None:   # the group's state is one vector already
+                acc = self.solver.step(dt, loads, rates).ravel()
+                out = np.concatenate((self.solver.y, acc))
+            else:
+                acc = self.bodies[0].step(dt, loads, rates)
+                out = np.concatenate((self.bodies[0]._y, acc))
+        except GimbalLockError as exc:   # the Euler angles' singularity: the body went over
+            self.error = f"capsized: {exc}"
+            return
         self.values[self._motion_vrs] = out
         self.checked = len(out) == len(self.output_vrs) and _finite(out.tolist())   # every output, then
+        tilt = out[self._tilt]
+        if max(tilt.max(), -tilt.min()) > self._watch:
+            self._watch_range(tilt, t + dt)
+
+    def _watch_range(self, tilt, t):
+        """Past the linear range: one warning per run; past CAPSIZE: the step fails, capsized."""
+        k = int(np.argmax(np.abs(tilt)))
+        var = self.vars[self._tilt_vrs[k]].name
+        angle = f"{var} ({'roll' if k % 2 == 0 else 'pitch'}) = {math.degrees(tilt[k]):.1f}° at t = {t:g} s"
+        if abs(tilt[k]) > CAPSIZE:
+            self.error = (f"capsized: {angle}: |roll| or |pitch| past {math.degrees(CAPSIZE):g}°, far outside "
+                          "the linear hydrostatics and first-order wave loads")
+            return
+        self.log(f"{self.instance_name}: left the linear range: {angle}, past {math.degrees(LINEAR_RANGE):g}°: "
+                 "the hydrostatics and first-order wave loads assume small angles (said once per run)",
+                 Fmi2Status.warning)
+        self._watch = CAPSIZE
 
     def physics_state(self):
         if not hasattr(self, "bodies"):

@@ -3,6 +3,8 @@ couplings of the mapped bodies), with their memory evaluator knobs."""
 import numpy as np
 
 from .. import keys
+from ..admissible import depth_mismatch
+from ..decks.bem import PERIOD_VARIABLES
 from ..description import HydroCoupling, Kernel
 from ..errors import InputError
 from ..names import did_you_mean
@@ -122,11 +124,13 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
     opt = {k: problems.number(table, k, f"{where}.{k}", positive=True) if k in table else None
            for k in ("ulen", "timdel", "kernel_length", "symmetry_tolerance")}
     a_inf_from = problems.choice(table, "a_inf", f"{where}.a_inf", ("ogilvie", "file"), "ogilvie")
+    variable = (problems.choice(table, "period_variable", f"{where}.period_variable", tuple(PERIOD_VARIABLES))
+                if "period_variable" in table else None)
     knobs = _memory_knobs(problems, table, where, memory)
     centres = problems.table(table, "rotation_centers", f"{where}.rotation_centers", required=False) or {}
     centres = {b: problems.vector(centres, b, f"{where}.rotation_centers.{b}", 3) for b in centres}
     if file is None or mapping is None or knobs[0] is None or prefix is None or not identifier(prefix) \
-            or a_inf_from is None or None in centres.values():
+            or a_inf_from is None or None in centres.values() or ("period_variable" in table and variable is None):
         if prefix is not None and not identifier(prefix):
             problems.add(f"{where}.name", f"expected an identifier, found {prefix!r}")
         return []
@@ -136,7 +140,12 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
         return []
     rho = env.get("rho") or 1025.0
     try:
-        data = read_bem(path, ulen=opt["ulen"], rho=rho)
+        data = read_bem(path, ulen=opt["ulen"], rho=rho, g=env.get("g") or 9.81, period_variable=variable)
+        mismatch = depth_mismatch(data.water_depth, env.get("depth"))
+        if mismatch:
+            raise InputError(path, None, "water_depth", f"{mismatch} (waves.depth): the radiation coefficients "
+                                                        "depend on the depth; solve again at the scene's depth, or "
+                                                        "set waves.depth to the result's")
         for name, scene_value in (("rho", rho), ("g", env.get("g") or 9.81)):
             value = getattr(data, name)
             if value is not None and abs(value - scene_value) > 1e-6 * scene_value:

@@ -136,14 +136,20 @@ def _riflex_body(problems, table, where):
 
 def _bem_entry(problems, table, where, reader):
     """(data read by ``reader``, file, BEM body name) of a BEM wave effect entry (keys bem,
-    body, ulen), or (None, None, None) after recording the problem."""
+    body, ulen, and period_variable when the effect takes it), or (None, None, None) after
+    recording the problem."""
+    from ..decks.bem import PERIOD_VARIABLES
     path = deck_path(problems, table, where, "bem")
     ulen = problems.number(table, "ulen", f"{where}.ulen", positive=True) if "ulen" in table else None
     body = problems.string(table, "body", f"{where}.body") if "body" in table else None
-    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None):
+    variable = (problems.choice(table, "period_variable", f"{where}.period_variable", tuple(PERIOD_VARIABLES))
+                if "period_variable" in table else None)
+    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None) \
+            or ("period_variable" in table and variable is None):
         return None, None, None
     env = getattr(problems, "env", {})
-    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81))
+    extra = (variable,) if "period_variable" in table else ()
+    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81), *extra)
     if data is None:
         return None, None, None
     if body is None:

@@ -12,7 +12,7 @@ from .couplings import read_couplings
 from .current import read_current
 from .joints import read_joint
 from .problems import Problems, identifier
-from .run import read_run
+from .run import read_run, stable_defaults
 from .waves import check_wave_effects, feels_waves, read_wave_points, read_waves
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")
@@ -99,14 +99,18 @@ def _load_scene(path, overrides=None):
         joint = read_joint(p, jname, jtable, f"joints.{jname}", bodies)
         if joint is not None:
             joints[jname] = joint
-    couplings = (read_couplings(p, doc["couplings"], bodies, run_cfg["memory"], {"rho": rho, "g": g})
+    sea = read_waves(p, doc["waves"]) if "waves" in doc else None   # before the couplings: its depth
+    couplings = (read_couplings(p, doc["couplings"], bodies, run_cfg["memory"],
+                                {"rho": rho, "g": g, "depth": sea.depth if sea is not None else None})
                  if "couplings" in doc else [])
     speed, direction, profile = read_current(p, env)
-    sea = read_waves(p, doc["waves"]) if "waves" in doc else None
     points = read_wave_points(p, doc["waves"], bodies) if "waves" in doc else {}
     feels = bool(points) or bool(joints) or any(feels_waves(e) for b in bodies.values() for e in b.effects)
     check_wave_effects(p, bodies, sea, rho, g, feels)
     _check_names(p, bodies, joints, couplings)
+    if None not in (run_cfg["step"], run_cfg["stop"]):
+        stable_defaults(run_cfg, bodies, couplings, sea,
+                        isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"])
     scene = Scene(
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,

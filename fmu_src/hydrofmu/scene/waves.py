@@ -6,9 +6,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import keys
+from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_problems, size_problem
 from .couplings import CENTRE_TOL
 
 WAVE_KEYS = keys.names(keys.WAVES)
+# the ramp a sea state gets unless [waves] sets one: this many peak periods (a start without
+# a ramp kicks a body that has no surge stiffness into a drift of hundreds of metres, docs/tuning.md)
+RAMP_PERIODS = 3.0
 
 
 def read_waves(problems, table):
@@ -42,13 +46,40 @@ def read_waves(problems, table):
     values["stretching"] = stretching
     for key in ("components", "seed"):
         values[key] = int(values[key]) if values[key] == int(values[key]) else values[key]
+    if "ramp" not in table:
+        values["ramp"] = RAMP_PERIODS * (values["period"] if spectrum == "regular" else values["tp"])
     sea = SeaState(spectrum, **values)
     try:
         sea.check()
     except WaveError as exc:
         problems.add(f"waves.{exc.field}", str(exc))
         return None
-    return sea
+    return sea if _plausible(problems, table, spectrum, values) else None
+
+
+# bytes a wave component holds in a load FMU: ω, a, β, φ and k, and the transfer function's
+# six complex values per body at it (a generous bound for a few bodies)
+COMPONENT_BYTES = 8 * 5 + 16 * 6 * 4
+
+
+def _plausible(problems, table, spectrum, values):
+    """What a sea can be (admissible.sea_problems: errors and warnings naming the key), the
+    keys this spectrum ignores (a warning naming them) and a component count that fits in
+    memory (an error before anything is allocated).  False after recording an error."""
+    errors, warns = sea_problems(spectrum, values, getattr(problems, "env", {}).get("g", 9.81))
+    too_big = size_problem(values["components"], COMPONENT_BYTES, "wave components")
+    if too_big and spectrum != "regular":
+        errors.append(("components", too_big))
+    for key, message in errors:
+        problems.add(f"waves.{key}", message)
+    for key, message in warns:
+        problems.warn(f"waves.{key}", message)
+    ignored = ignored_wave_keys(spectrum, table)
+    if ignored:
+        problems.warn(f"waves.{ignored[0]}", f"{', '.join(ignored)} {'is' if len(ignored) == 1 else 'are'} not read "
+                                             f"by spectrum = {spectrum!r} (it reads "
+                                             f"{', '.join(sorted(WAVE_KEYS_USED[spectrum]))}): left out")
+    return not errors
 
 
 POINT_KEYS = keys.names(keys.WAVE_POINT)
@@ -124,10 +155,10 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
                            f"{body.name!r} is at {body.position} m: the transfer functions are about the rotation centre "
                            f"and their phases refer to the body's place (move the body or solve again)")
             if eff.type == "wave_excitation":
-                depth = d.get("water_depth")
-                if sea is not None and depth is not None and not (depth == sea.depth or
-                                                                  abs(depth - sea.depth) <= 1e-6 * sea.depth):
-                    bad.append(f"water_depth = {depth:g} m in {name} but waves.depth = {sea.depth:g} m")
+                mismatch = depth_mismatch(d.get("water_depth"), sea.depth if sea is not None else None)
+                if mismatch:
+                    bad.append(f"{mismatch} (waves.depth; {name}'s water_depth): solve again at the scene's depth, "
+                               "or set waves.depth to the result's")
                 elif not bad:
                     values = np.asarray(d["re"]) + 1j * np.asarray(d["im"])
                     try:
