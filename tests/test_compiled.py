@@ -731,10 +731,15 @@ def test_wave_kernel_equals_the_python_one(tmp_path):
         assert int(params[0]) == n and np.allclose(params[2:2 + n], wave.omega, rtol=1e-13, atol=0)
         out = (ctypes.c_double * 7)()
         ref, got = [], []
-        for t in np.linspace(-1.0, 200.0, 2011):
-            lib.hf_waves(params, ctypes.c_double(t), out)
+        lib.hf_wave_phasors.restype = ctypes.c_void_p
+        phasors = ctypes.c_void_p(lib.hf_wave_phasors(params))
+        # fixed steps (the phasors rotate), then variable ones and a jump back (exact)
+        times = np.r_[np.linspace(-1.0, 200.0, 2011), np.cumsum(rng.uniform(0.01, 0.3, 300)), 7.0, 7.1]
+        for t in times:
+            lib.hf_waves(params, phasors, ctypes.c_double(t), out)
             got.append(list(out))
             ref.append(wave(t))
+        lib.hf_phasors_delete(phasors)
         ref, got = np.array(ref), np.array(got)
         span = ref.max(axis=0) - ref.min(axis=0)
         assert (span > 0).all() and np.all(np.abs(got - ref).max(axis=0) <= 1e-12 * span), sea

@@ -98,7 +98,20 @@ def test_capytaine_regenerates_the_buoy_data():
         np.testing.assert_allclose(a, b.values, rtol=1e-6, atol=1e-9 * np.abs(b.values).max(), err_msg=var)
 
 
-@pytest.mark.parametrize("name", ["build_and_run", "step_sweep", "own_master", "read_results", "waves_statistics"])
+def test_wave_probe_gives_a_second_fmu_the_same_sea(tmp_path):
+    # barge A's load FMU's named point read by a pythonfmu sphere through our own fmpy loop:
+    # the velocity it got is Airy of the scene's components (Wheeler, ramped) written in the example
+    worst, rows = example("wave_probe").main(["--stop", "8", "--out", str(tmp_path)])
+    assert worst < 1e-12 and np.abs(rows[:, 1:4]).max() > 0.05
+    u, a, f = rows[:, 1:4], rows[:, 4:7], rows[:, 8:11]
+    rho, r = 1025.0, 0.5   # the sphere's Morison force on what it was given
+    want = 0.5 * rho * np.pi * r * r * np.linalg.norm(u, axis=1)[:, None] * u + rho * 2 * 4 / 3 * np.pi * r ** 3 * a
+    np.testing.assert_allclose(f, want, rtol=1e-12, atol=1e-9)
+    assert (tmp_path / "wave_probe" / "probe.csv").is_file()
+
+
+@pytest.mark.parametrize("name", ["build_and_run", "step_sweep", "own_master", "read_results", "waves_statistics",
+                                  "wave_probe"])
 def test_examples_are_scripts(name):
     import subprocess
     import sys

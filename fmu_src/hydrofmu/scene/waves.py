@@ -19,7 +19,7 @@ RAMP_PERIODS = 3.0
 def read_waves(problems, table):
     """The sea state of ``[waves]`` (physics.waves.SeaState), checked; None after recording
     the problems."""
-    from ..physics.waves import SPECTRA, SeaState, WaveError
+    from ..physics.waves import SPECTRA, STRETCHING, SeaState, WaveError
     if not isinstance(table, dict):
         problems.add("waves", "expected a table [waves]")
         return None
@@ -30,7 +30,8 @@ def read_waves(problems, table):
     need = ("height", "period") if spectrum == "regular" else ("hs", "tp")
     defaults = SeaState()
     values = {}
-    for key in WAVE_KEYS - {"spectrum", "depth"}:
+    stretching = problems.choice(table, "stretching", "waves.stretching", STRETCHING, "wheeler")
+    for key in WAVE_KEYS - {"spectrum", "depth", "stretching", "points"}:
         if key in table or key not in need:
             values[key] = problems.number(table, key, f"waves.{key}", getattr(defaults, key))
         else:
@@ -41,8 +42,9 @@ def read_waves(problems, table):
         values["depth"] = math.inf
     else:
         values["depth"] = problems.number(table, "depth", "waves.depth", positive=True)
-    if None in values.values():
+    if None in values.values() or stretching is None:
         return None
+    values["stretching"] = stretching
     for key in ("components", "seed"):
         values[key] = int(values[key]) if values[key] == int(values[key]) else values[key]
     if "ramp" not in table:
@@ -85,12 +87,61 @@ def _plausible(problems, table, spectrum, values):
     return not errors
 
 
-def check_wave_effects(problems, bodies, sea, rho, g):
+POINT_KEYS = keys.names(keys.WAVE_POINT)
+
+
+def feels_waves(effect):
+    """True for an effect that feels the incident-wave kinematics (a RIFLEX body always, an
+    AQWA drag or a DeepLines polar with ``waves = true``)."""
+    return effect.data is not None and (effect.type == "riflex_body" or bool(effect.data.get("waves")))
+
+
+def read_wave_points(problems, table, bodies):
+    """``[waves.points.NAME]``: {name: {"position": global (3)} or {"body": name, "offset": (3)}},
+    in the file's order; each name an identifier (it prefixes FMU variables)."""
+    from .problems import identifier
+    raw = table.get("points", {}) if isinstance(table, dict) else {}
+    if not isinstance(raw, dict):
+        problems.add("waves.points", "expected a table of named points [waves.points.NAME]")
+        return {}
+    points = {}
+    for name, entry in raw.items():
+        where = f"waves.points.{name}"
+        if not identifier(name):
+            problems.add(where, f"a point's name must be an identifier (it names FMU variables), found {name!r}")
+            continue
+        if not isinstance(entry, dict):
+            problems.add(where, "expected a table with position, or body and offset")
+            continue
+        problems.known_keys(entry, where, POINT_KEYS)
+        if ("position" in entry) == ("body" in entry):
+            problems.add(where, "give either position (a fixed global point) or body (and offset: a point on it)")
+            continue
+        if "position" in entry:
+            if "offset" in entry:
+                problems.add(f"{where}.offset", "offset is a point on a body: give body too, or only position")
+                continue
+            pos = problems.vector(entry, "position", f"{where}.position", 3)
+            if pos is not None:
+                points[name] = {"position": pos}
+            continue
+        body = problems.string(entry, "body", f"{where}.body")
+        offset = problems.vector(entry, "offset", f"{where}.offset", 3, [0.0, 0.0, 0.0])
+        if body is not None and body not in bodies:
+            problems.add(f"{where}.body", f"no body {body!r} in the scene (bodies: {', '.join(bodies) or 'none'})")
+            continue
+        if body is not None and offset is not None:
+            points[name] = {"body": body, "offset": offset}
+    return points
+
+
+def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
     """Checks of the BEM wave effects against the scene: rho, g, depth, rotation centres at the
     reference points (positions matter to the excitation's phase: no shift allowed), the sea
     state within every transfer function (frequencies, directions), the hydrostatics' mass,
     centre of mass and weight terms against the body's, and no restoring counted twice.
-    Fills each hydrostatics effect's equilibrium pose."""
+    Fills each hydrostatics effect's equilibrium pose.  ``feels``: something other than an
+    excitation feels the waves (kinematics: RIFLEX bodies, CONB nodes, drags with waves, points)."""
     from ..physics.kinematics import rotation
     from ..physics.waves import TransferFunction, WaveError, components
     tfs = []
@@ -137,8 +188,9 @@ def check_wave_effects(problems, bodies, sea, rho, g):
             problems.warn(where, "no [waves] in the scene: this body's wave excitation is left out of its FMU")
         return
     if not tfs:
-        if not problems.items:
-            problems.warn("waves", "no body has a wave_excitation effect: the sea state acts on nothing")
+        if not problems.items and not feels:
+            problems.warn("waves", "no body has a wave_excitation effect, a RIFLEX body, a drag with waves = true or "
+                                   "named points: the sea state acts on nothing")
         return
     lo = max(tf.window[0] for _, _, tf in tfs)
     hi = min(tf.window[1] for _, _, tf in tfs)
