@@ -41,6 +41,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.random  # noqa: F401  (now, as the FMU loads: its first use, in components(), imports threading,
+# and threading first imported on a host's worker thread hangs a libcosimpy process at exit)
 
 SPECTRA = ("regular", "jonswap", "pierson_moskowitz")
 STRETCHING = ("none", "vertical", "wheeler", "extrapolation")   # wave_kinematics.py's options
