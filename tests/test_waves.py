@@ -300,3 +300,26 @@ def test_capytaine_regenerates_the_wave_data():
             a = xr.concat([a.real, a.imag], dim="complex").assign_coords(complex=["re", "im"])
         a = a.transpose(*b.dims).values
         np.testing.assert_allclose(a, b.values, rtol=1e-6, atol=1e-9 * np.abs(b.values).max(), err_msg=var)
+
+
+def test_a_sea_made_on_a_host_worker_thread_lets_the_process_exit():
+    """A host (libcosimpy) steps FMUs on its own worker threads: the sea's components made
+    there must not import threading for the first time (numpy.random did), or the interpreter
+    hangs at exit in threading._shutdown.  A fresh process makes them on a bare _thread and
+    exits while that thread is still alive."""
+    import subprocess
+    import sys
+    code = ("import _thread, sys, time\n"
+            "from hydrofmu.physics.waves import SeaState, components\n"
+            "done = []\n"
+            "def work():\n"
+            "    components(SeaState(hs=2.0, tp=8.0), (0.05, 4.0))\n"
+            "    done.append(1)\n"
+            "    while True:\n"          # alive, as a host's worker pool is, when the process exits
+            "        time.sleep(1)\n"
+            "_thread.start_new_thread(work, ())\n"
+            "while not done:\n"
+            "    time.sleep(0.01)\n"
+            "print('made')\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0 and run.stdout.strip() == "made", run.stderr
