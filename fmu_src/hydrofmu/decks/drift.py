@@ -1,0 +1,420 @@
+"""Readers for second-order wave drift: mean drift (WAMIT ``.7/.8/.9``, Capytaine far-field
+drift) and difference-frequency QTFs (WAMIT ``.10d/.11d/.12d``).
+
+Every source is brought to hydrofmu's convention (DESIGN.md, Waves (second order)):
+
+    F(t) = Σ_i Σ_j a_i·a_j·Re{Q⁻(ω_i, ω_j; β_i, β_j)·e^{i((ω_i − ω_j)t + φ_i − φ_j)}}
+
+for the elevation η = Σ a_k·cos(ω_k·t + φ_k) at the global origin, β [deg] where the waves
+go to, counter-clockwise from +x; Q⁻(ω_j, ω_i; β_j, β_i) = conj(Q⁻(ω_i, ω_j; β_i, β_j)), so
+the mean drift of a regular wave of amplitude a is a²·Q⁻(ω, ω; β, β) (real).  Q in SI per
+unit amplitude squared: N/m² (forces), N·m/m² (moments), global axes, moments about the
+body's reference point (the BEM rotation centre / WAMIT's body origin).
+
+WAMIT (manual, chapter 4 and the second-order chapter; time factor e^{+iωt}, phases relative
+to the incident elevation at the origin, A the complex amplitude a·e^{iφ}):
+
+- ``.7`` (control surface), ``.8`` (momentum conservation), ``.9`` (pressure integration):
+  lines ``PER BETA1 BETA2 I Mod Pha Re Im``, F̄ = F/(ρ·g·A²·L^k), k = 1 forces, 2 moments
+  (L = ``ulen``).  ``.8`` has I = 1, 2, 6 only (heave, roll, pitch read as zero by its
+  definition; a ``.8`` row with I = 3, 4, 5 or a second body is refused).  Rows with
+  BETA1 = BETA2 are the mean drift of a unidirectional wave (real: an imaginary part above
+  1e-6 of the modulus is refused); rows with BETA1 ≠ BETA2 (bidirectional, WAMIT's
+  Re{A₁A₂*·F̄}) are kept in ``cross`` and not used by the mean drift of a sea (the
+  cross terms of two random-phase components average to zero).
+- ``.10d`` / ``.11d`` / ``.12d``: lines ``PER1 PER2 BETA1 BETA2 I Mod Pha Re Im``, the same
+  non-dimensionalisation, WAMIT's own difference-frequency form
+  F = Re Σ_i Σ_j A_i·A_j*·F̄⁻_ij·e^{i(ω_i − ω_j)t} = ours, no conversion.  One triangle is
+  enough (the other is its complex conjugate with the headings swapped); a pair written in
+  both triangles must agree (1e-6 of the larger modulus, 1e-12 absolute); a pair of the
+  frequency grid written in neither is an error.  The diagonal (PER1 = PER2, BETA1 = BETA2)
+  is the mean drift.
+
+Both: a first line that is not numbers is a header (WAMIT's NUMHDR = 1: "WAMIT Numeric
+Output -- Filename …"), anywhere else a line that is not numbers is an error at that line;
+a row with fewer or more fields than the layout is an error at the line; PER = 0 and −1
+(the zero and infinite periods) are skipped (no drift there); a repeated key is an error
+naming both lines; a dof given at some (periods, headings) and missing at others is an
+error (a truncated file); a dof missing at every one is zero (WAMIT leaves out what it does
+not compute), said in ``warnings``.
+
+Capytaine (needs the `bem` extra): a dataset as ``cpt.export_dataset`` writes it with a
+variable ``mean_drift_force`` over (omega, wave_direction [rad], influenced_dof), as
+``cpt.post_pro.far_field_mean_drift_force`` computes it (``hydrofmu drift2nc`` adds it to a
+user's dataset).  That function returns the mean force on the body per unit wave amplitude
+squared, N/m², for the wave of amplitude 1 (Capytaine's e^{−iωt}: the mean of a product of
+two first-order quantities is the same in either time convention, no conjugation), dofs
+Surge, Sway (and Yaw when asked); it is a² Q(ω, ω; β, β) with a = 1, read as written.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .lines import fortran_float
+
+MEAN_SUFFIXES = (".7", ".8", ".9")
+QTF_SUFFIXES = (".10d", ".11d", ".12d")
+CONJ_RTOL = 1e-6      # a pair written in both triangles: conj agreement, relative to the larger modulus
+REAL_RTOL = 1e-6      # a unidirectional mean drift's imaginary part, relative to its modulus
+HEADING_TOL = 1e-6    # deg
+
+
+@dataclass
+class MeanDriftData:
+    """Mean drift of a BEM result in SI units (module docstring's convention).
+
+    omega (nω,) [rad/s] increasing; directions (nβ,) [deg]; values (nω, nβ, n) real
+    [N/m², N·m/m²] = Q(ω, ω; β, β); dofs [(body, k)]; bodies [names]; cross
+    {(β1, β2): (nω, n) complex} the bidirectional entries (WAMIT BETA1 ≠ BETA2), not used for
+    the mean drift of a sea; warnings: legal but said."""
+    path: str
+    kind: str
+    omega: np.ndarray
+    directions: np.ndarray
+    values: np.ndarray
+    dofs: list
+    bodies: list
+    cross: dict = field(default_factory=dict)
+    rotation_centers: dict = field(default_factory=dict)
+    rho: float = None
+    g: float = None
+    water_depth: float = None
+    warnings: list = field(default_factory=list)
+
+    def body(self, name):
+        """(nω, nβ, 6) real of one body, zero for dofs the file leaves out."""
+        out = np.zeros(self.values.shape[:2] + (6,))
+        for c, (b, k) in enumerate(self.dofs):
+            if b == name:
+                out[:, :, k - 1] = self.values[:, :, c]
+        return out
+
+
+@dataclass
+class QTFData:
+    """Difference-frequency QTF of a BEM result in SI units (module docstring's convention).
+
+    omega (nω,) [rad/s] increasing; pairs [(β1, β2)] [deg] the heading pairs the file holds;
+    values (nω, nω, nP, n) complex [N/m², N·m/m²], Q⁻(ω_i, ω_j; β1, β2) with both triangles
+    filled (Q(ω_j, ω_i; β2, β1) = conj Q(ω_i, ω_j; β1, β2)); dofs [(body, k)]; bodies."""
+    path: str
+    kind: str
+    omega: np.ndarray
+    pairs: list
+    values: np.ndarray
+    dofs: list
+    bodies: list
+    rotation_centers: dict = field(default_factory=dict)
+    rho: float = None
+    g: float = None
+    water_depth: float = None
+    warnings: list = field(default_factory=list)
+
+    def body(self, name):
+        """(nω, nω, nP, 6) complex of one body, zero for dofs the file leaves out."""
+        out = np.zeros(self.values.shape[:3] + (6,), complex)
+        for c, (b, k) in enumerate(self.dofs):
+            if b == name:
+                out[..., k - 1] = self.values[..., c]
+        return out
+
+    def mean(self) -> MeanDriftData:
+        """The diagonal (ω_i = ω_j, β1 = β2): the mean drift, real by the conjugate symmetry."""
+        uni = [p for p, (b1, b2) in enumerate(self.pairs) if abs(b1 - b2) <= HEADING_TOL]
+        if not uni:
+            raise InputError(self.path, None, "BETA1 BETA2", "no unidirectional heading pair (BETA1 = BETA2): "
+                                                             "no mean drift in the file")
+        idx = np.arange(self.omega.size)
+        diag = self.values[idx, idx][:, uni, :]
+        return MeanDriftData(self.path, self.kind, self.omega, np.array([self.pairs[p][0] for p in uni]),
+                             diag.real.copy(), self.dofs, self.bodies, rotation_centers=self.rotation_centers,
+                             rho=self.rho, g=self.g, water_depth=self.water_depth, warnings=list(self.warnings))
+
+
+def read_mean_drift(path, ulen=None, rho=None, g=None) -> MeanDriftData:
+    """Mean drift of a WAMIT .7/.8/.9 file (``ulen`` [m], ``rho``, ``g`` make it dimensional),
+    a WAMIT .10d/.11d/.12d (its diagonal) or a Capytaine dataset (.nc) holding
+    ``mean_drift_force``."""
+    path = Path(path)
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        return _capytaine_mean(path)
+    if path.suffix in MEAN_SUFFIXES:
+        return _wamit_mean(path, ulen, rho, g)
+    if path.suffix in QTF_SUFFIXES:
+        return read_qtf(path, ulen, rho, g).mean()
+    raise InputError(path, None, "bem", "expected a WAMIT mean drift file (.7 control surface, .8 momentum, "
+                                        ".9 pressure), a WAMIT QTF (.10d/.11d/.12d) or a Capytaine dataset (.nc) "
+                                        "with mean_drift_force")
+
+
+def read_qtf(path, ulen=None, rho=None, g=None) -> QTFData:
+    """Difference-frequency QTF of a WAMIT .10d/.11d/.12d file."""
+    path = Path(path)
+    if path.suffix not in QTF_SUFFIXES:
+        raise InputError(path, None, "bem", "expected a WAMIT difference-frequency QTF file (.10d, .11d or .12d)")
+    return _wamit_qtf(path, ulen, rho, g)
+
+
+# ---------------------------------------------------------------------------- WAMIT
+
+def _scale_checked(path, ulen, rho, g):
+    for name, v in (("ulen", ulen), ("rho", rho), ("g", g)):
+        if v is None or not v > 0:
+            raise InputError(path, None, name, f"a WAMIT file is nondimensional: declare {name} (> 0)")
+
+
+def _is_number(word):
+    try:
+        fortran_float(word)
+        return True
+    except ValueError:
+        return False
+
+
+def _rows(path, names):
+    """[(line number, [floats])] of a WAMIT numeric file with exactly len(names) fields per
+    row; a first line that is not numbers is WAMIT's header (NUMHDR = 1)."""
+    try:
+        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+    except OSError as exc:
+        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
+    rows = []
+    layout = " ".join(names)
+    top = next((n for n, line in enumerate(text, 1) if line.split()), None)
+    for number, line in enumerate(text, 1):
+        words = line.replace(",", " ").split()
+        if not words:
+            continue
+        if number == top and not _is_number(words[0]):
+            continue                                   # WAMIT's header line (NUMHDR = 1)
+        if len(words) != len(names):
+            raise InputError(path, number, layout, f"expected {len(names)} fields, found {len(words)}: "
+                                                   f"{line.strip()!r}")
+        vals = []
+        for name, w in zip(names, words):
+            try:
+                v = fortran_float(w)
+            except ValueError:
+                raise InputError(path, number, name, f"not a number: {w!r}") from None
+            if not np.isfinite(v):
+                raise InputError(path, number, name, f"non-finite value {w!r}")
+            vals.append(v)
+        rows.append((number, vals))
+    if not rows:
+        raise InputError(path, None, layout, "no data rows")
+    return rows
+
+
+def _dof_index(path, number, value):
+    if value != int(value) or value < 1:
+        raise InputError(path, number, "I", f"dof index must be a positive integer, found {value:g}")
+    return int(value)
+
+
+def _period(path, number, per, name="PER"):
+    """The period [s] of a row, None for the zero / infinite period limits."""
+    if per in (0.0, -1.0):
+        return None
+    if per < 0:
+        raise InputError(path, number, name, f"period must be > 0 (0 and −1: the limits), found {per:g}")
+    return per
+
+
+def _heading(b):
+    """Headings are compared on a 1e-6° grid (WAMIT writes them with a few decimals)."""
+    return round(float(b), 6)
+
+
+def _dim(value, i, rho, g, ulen):
+    """WAMIT F̄ → SI per unit amplitude squared: ρ·g·L^k, k = 1 forces, 2 moments."""
+    return value * rho * g * ulen ** (1 if (i - 1) % 6 < 3 else 2)
+
+
+def _missing_dofs(path, table, keys, first):
+    """Dofs given at some keys and missing at others: an error at the last line of the first
+    incomplete key; returns the given dofs (sorted)."""
+    given = sorted({i for k in keys for i in table[k]})
+    for k in keys:
+        gap = [i for i in given if i not in table[k]]
+        if gap:
+            last = max(first[k + (i,)] for i in table[k])
+            raise InputError(path, last, "I", f"dof(s) {gap} given elsewhere are missing at {_key_text(k)} "
+                                              f"(its rows end at line {last}): a truncated file?")
+    return given
+
+
+def _key_text(k):
+    if len(k) == 3:
+        return f"PER = {k[0]:g} s, BETA1 = {k[1]:g}°, BETA2 = {k[2]:g}°"
+    return f"PER1 = {k[0]:g} s, PER2 = {k[1]:g} s, BETA1 = {k[2]:g}°, BETA2 = {k[3]:g}°"
+
+
+def _dof_warning(path, given, kind):
+    want = [1, 2, 6] if kind == ".8" else list(range(1, 7))
+    absent = [i for i in want if i not in given and ((i - 1) // 6) == 0]
+    if not absent or max(given) > 6:
+        return []
+    return [f"{path}: dof(s) {absent} not in the file: read as zero (WAMIT leaves out what it does not compute)"]
+
+
+def _wamit_mean(path, ulen, rho, g):
+    _scale_checked(path, ulen, rho, g)
+    rows = _rows(path, ["PER", "BETA1", "BETA2", "I", "MOD", "PHA", "RE", "IM"])
+    table, first = {}, {}
+    for number, (per, b1, b2, i, _, _, re, im) in rows:
+        per = _period(path, number, per)
+        if per is None:
+            continue
+        i = _dof_index(path, number, i)
+        if path.suffix == ".8" and i not in (1, 2, 6):
+            raise InputError(path, number, "I", f"a .8 (momentum conservation) holds I = 1, 2, 6 of one body only, "
+                                                f"found I = {i} (a .9 or .7 renamed?)")
+        b1, b2 = _heading(b1), _heading(b2)
+        key = (per, b1, b2, i)
+        if key in first:
+            raise InputError(path, number, "PER BETA1 BETA2 I", f"duplicate ({per:g}, {b1:g}, {b2:g}, {i}) (first at "
+                                                                f"line {first[key]})")
+        first[key] = number
+        if b1 == b2 and abs(im) > REAL_RTOL * max(abs(complex(re, im)), 1e-300) and abs(im) > 1e-12:
+            raise InputError(path, number, "IM", f"the mean drift of a unidirectional wave (BETA1 = BETA2) is real, "
+                                                 f"found Im = {im:g} against Re = {re:g}")
+        table.setdefault((per, b1, b2), {})[i] = complex(re, im)
+    keys = sorted(table)
+    given = _missing_dofs(path, table, keys, first)
+    periods = sorted({k[0] for k in keys}, reverse=True)          # increasing ω
+    uni = sorted({k[1] for k in keys if k[1] == k[2]})
+    if len(periods) < 2:
+        raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 2 needed")
+    if not uni:
+        raise InputError(path, None, "BETA1 BETA2", "no unidirectional rows (BETA1 = BETA2): no mean drift")
+    for per in periods:
+        for b in uni:
+            if (per, b, b) not in table:
+                near = max((first[k + (i,)] for k in keys if k[0] == per for i in table[k]), default=None)
+                raise InputError(path, near, "PER BETA1 BETA2", f"no rows for PER = {per:g} s at BETA1 = BETA2 = "
+                                                                f"{b:g}° (given at other periods): every period must "
+                                                                f"list the same headings")
+    values = np.array([[[_dim(table[(p, b, b)][i].real, i, rho, g, ulen) for i in given] for b in uni]
+                       for p in periods])
+    cross = {}
+    for (p, b1, b2) in keys:
+        if b1 != b2:
+            cross.setdefault((b1, b2), np.full((len(periods), len(given)), np.nan, complex))
+            cross[(b1, b2)][periods.index(p)] = [_dim(table[(p, b1, b2)][i], i, rho, g, ulen) for i in given]
+    for (b1, b2), v in cross.items():
+        if np.isnan(v.real).any():
+            p = periods[int(np.argwhere(np.isnan(v.real).any(axis=1))[0][0])]
+            raise InputError(path, None, "PER BETA1 BETA2", f"bidirectional pair ({b1:g}°, {b2:g}°) missing at "
+                                                            f"PER = {p:g} s (given at other periods)")
+    dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
+    bodies = list(dict.fromkeys(b for b, _ in dofs))
+    return MeanDriftData(str(path), f"WAMIT {path.suffix}", 2 * np.pi / np.array(periods), np.array(uni, float),
+                         values, dofs, bodies, cross=cross, warnings=_dof_warning(path, given, path.suffix))
+
+
+def _wamit_qtf(path, ulen, rho, g):
+    _scale_checked(path, ulen, rho, g)
+    rows = _rows(path, ["PER1", "PER2", "BETA1", "BETA2", "I", "MOD", "PHA", "RE", "IM"])
+    table, first = {}, {}
+    for number, (p1, p2, b1, b2, i, _, _, re, im) in rows:
+        p1, p2 = _period(path, number, p1, "PER1"), _period(path, number, p2, "PER2")
+        if p1 is None or p2 is None:
+            continue
+        i = _dof_index(path, number, i)
+        b1, b2 = _heading(b1), _heading(b2)
+        key = (p1, p2, b1, b2, i)
+        if key in first:
+            raise InputError(path, number, "PER1 PER2 BETA1 BETA2 I", f"duplicate ({p1:g}, {p2:g}, {b1:g}, {b2:g}, "
+                                                                      f"{i}) (first at line {first[key]})")
+        first[key] = number
+        table.setdefault((p1, p2, b1, b2), {})[i] = _dim(complex(re, im), i, rho, g, ulen)
+    keys = sorted(table)
+    given = _missing_dofs(path, table, keys, first)
+    periods = sorted({k[0] for k in keys} | {k[1] for k in keys}, reverse=True)    # increasing ω
+    if len(periods) < 2:
+        raise InputError(path, None, "PER1 PER2", f"{len(periods)} finite periods: at least 2 needed")
+    pairs = sorted({(k[2], k[3]) for k in keys} | {(k[3], k[2]) for k in keys})
+    n, npair, nd = len(periods), len(pairs), len(given)
+    pos = {p: k for k, p in enumerate(periods)}
+    ppos = {p: k for k, p in enumerate(pairs)}
+    q = np.full((n, n, npair, nd), np.nan, complex)
+    line = np.zeros((n, n, npair), int)
+    for (p1, p2, b1, b2), vals in table.items():
+        i, j, h, hc = pos[p1], pos[p2], ppos[(b1, b2)], ppos[(b2, b1)]
+        v = np.array([vals[d] for d in given])
+        number = max(first[(p1, p2, b1, b2, d)] for d in given)
+        for (a, b, c, val) in ((i, j, h, v), (j, i, hc, np.conj(v))):
+            if line[a, b, c]:
+                old = q[a, b, c]
+                scale = np.maximum(np.abs(old), np.abs(val))
+                if np.any(np.abs(old - val) > CONJ_RTOL * scale + 1e-12 * max(rho * g * ulen ** 2, 1.0)):
+                    raise InputError(path, number, "RE IM", f"{_key_text((p1, p2, b1, b2))} is written in both "
+                                                            f"triangles but is not the complex conjugate of its mirror "
+                                                            f"(line {line[a, b, c]})")
+            q[a, b, c], line[a, b, c] = val, number
+    holes = np.argwhere(line == 0)
+    if holes.size:
+        a, b, c = holes[0]
+        raise InputError(path, None, "PER1 PER2 BETA1 BETA2",
+                         f"{len(holes)} (PER1, PER2, headings) combination(s) written in neither triangle, first "
+                         f"PER1 = {periods[a]:g} s, PER2 = {periods[b]:g} s, headings {pairs[c]} (the file's periods "
+                         f"make a {n} × {n} grid; every pair must be in one triangle)")
+    idx = np.arange(n)
+    for c, (b1, b2) in enumerate(pairs):
+        if b1 == b2:
+            d = q[idx, idx, c]
+            bad = np.abs(d.imag) > REAL_RTOL * np.abs(d) + 1e-12
+            if bad.any():
+                k, m = np.argwhere(bad)[0]
+                raise InputError(path, line[k, k, c], "IM", f"the diagonal (PER1 = PER2 = {periods[k]:g} s, "
+                                                            f"BETA1 = BETA2 = {b1:g}°) is the mean drift, real; "
+                                                            f"found Im = {d[k, m].imag:g}")
+            q[idx, idx, c] = d.real
+    dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
+    bodies = list(dict.fromkeys(b for b, _ in dofs))
+    return QTFData(str(path), f"WAMIT {path.suffix}", 2 * np.pi / np.array(periods), pairs, q, dofs, bodies,
+                   warnings=_dof_warning(path, given, path.suffix))
+
+
+# ---------------------------------------------------------------------------- Capytaine
+
+def _capytaine_mean(path):
+    from .bem_waves import _centres, _dof, _open, _scalar
+    ds = _open(path)
+    name = "mean_drift_force"
+    if name not in ds:
+        raise InputError(path, None, name, "missing: add the far-field mean drift to the dataset with "
+                                           "`hydrofmu drift2nc` (Capytaine's post_pro.far_field_mean_drift_force)")
+    var = ds[name]
+    if "complex" in var.dims:
+        raise InputError(path, None, name, "expected real values (the mean drift), found a 'complex' dimension")
+    want = ("omega", "wave_direction", "influenced_dof")
+    if sorted(var.dims) != sorted(want):
+        raise InputError(path, None, name, f"expected dimensions {want}, found {tuple(var.dims)}")
+    q = np.moveaxis(var.values.astype(float), [var.dims.index(d) for d in want], [0, 1, 2])
+    omega = ds["omega"].values.astype(float)
+    keep = np.isfinite(omega) & (omega > 0)
+    omega, q = omega[keep], q[keep]
+    order = np.argsort(omega)
+    omega, q = omega[order], q[order]
+    if omega.size < 2 or np.any(np.diff(omega) <= 0):
+        raise InputError(path, None, "omega", "at least two distinct finite frequencies needed for the mean drift")
+    rad = np.atleast_1d(ds["wave_direction"].values.astype(float))
+    if np.any(np.abs(rad) > 2 * np.pi + 1e-9):
+        raise InputError(path, None, "wave_direction", f"{rad[np.argmax(np.abs(rad))]:g} is beyond ±2π: Capytaine "
+                                                       "gives directions in radians")
+    names = [str(n) for n in np.atleast_1d(ds["influenced_dof"].values)]
+    dofs = [_dof(path, n, ds, "influenced_dof") for n in names]
+    bad = ~np.isfinite(q)
+    if bad.any():
+        i, j, k = np.argwhere(bad)[0]
+        raise InputError(path, None, name, f"{bad.sum()} non-finite value(s), first at omega={omega[i]:g} rad/s, "
+                                           f"wave_direction={np.degrees(rad[j]):g}°, influenced_dof={names[k]}")
+    bodies = list(dict.fromkeys(b for b, _ in dofs))
+    return MeanDriftData(str(path), "Capytaine", omega, np.degrees(rad), q, dofs, bodies,
+                         rotation_centers=_centres(ds, bodies), rho=_scalar(ds, "rho", path),
+                         g=_scalar(ds, "g", path), water_depth=_scalar(ds, "water_depth", path))

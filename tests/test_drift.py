@@ -1,0 +1,241 @@
+"""Second-order wave drift (issue 33): the readers' conventions on files written here as WAMIT
+writes them, and the drift kernels against answers computed independently in the tests."""
+import math
+
+import numpy as np
+import pytest
+
+from hydrofmu.decks.drift import read_mean_drift, read_qtf
+from hydrofmu.errors import InputError
+from hydrofmu.physics.drift import QTF, DriftLoad, MeanDrift, phasors
+from hydrofmu.physics.waves import Components, SeaState, WaveError, components, spectrum
+
+RHO, G, ULEN = 1025.0, 9.81, 2.0
+
+
+def wamit_line(*fields):
+    """One row as WAMIT's numeric files write it (E13.6-like reals, I-format index)."""
+    out = []
+    for f in fields:
+        out.append(f"{f:6d}" if isinstance(f, int) else f"{f:14.6E}")
+    return "".join(out) + "\n"
+
+
+def mean_rows(periods, headings, dofs, value):
+    rows = []
+    for per in periods:
+        for b in headings:
+            for i in dofs:
+                v = complex(value(per, b, i))
+                rows.append(wamit_line(per, b, b, i, abs(v), math.degrees(np.angle(v)), v.real, v.imag))
+    return rows
+
+
+HEADER = " WAMIT Numeric Output -- Filename  test.8   28-Nov-2026  12:00:00\n"
+
+
+def f8(per, b, i):   # a smooth non-dimensional mean drift, different per dof, heading and period
+    return (0.1 * i + 0.01 * b / 45.0) * (1 + 3.0 / per)
+
+
+def test_wamit_mean_drift_dimensions_headings_and_header(tmp_path):
+    path = tmp_path / "barge.8"
+    path.write_text(HEADER + "".join(mean_rows([10.0, 8.0, 5.0], [0.0, 45.0], [1, 2, 6], f8)))
+    d = read_mean_drift(path, ULEN, RHO, G)
+    assert d.kind == "WAMIT .8" and d.bodies == ["body1"] and d.dofs == [("body1", 1), ("body1", 2), ("body1", 6)]
+    assert np.allclose(d.omega, 2 * np.pi / np.array([10.0, 8.0, 5.0]))
+    q = d.body("body1")
+    for a, per in enumerate([10.0, 8.0, 5.0]):
+        for h, b in enumerate([0.0, 45.0]):
+            assert q[a, h, 0] == pytest.approx(f8(per, b, 1) * RHO * G * ULEN, rel=1e-6)     # forces: ρgL
+            assert q[a, h, 5] == pytest.approx(f8(per, b, 6) * RHO * G * ULEN ** 2, rel=1e-6)  # moments: ρgL²
+            assert q[a, h, 2] == 0.0 and q[a, h, 3] == 0.0
+    assert d.warnings == []      # .8 has I = 1, 2, 6 by definition: nothing to say
+
+
+def test_wamit_mean_drift_refuses_what_it_cannot_read(tmp_path):
+    def refused(name, text, field, line=None):
+        p = tmp_path / name
+        p.write_text(text)
+        with pytest.raises(InputError) as e:
+            read_mean_drift(p, ULEN, RHO, G)
+        assert e.value.field == field and e.value.line == line, str(e.value)
+        return str(e.value)
+    rows = mean_rows([10.0, 8.0], [0.0], [1, 2, 6], f8)
+    refused("a.8", HEADER + "".join(rows[:-1]) + rows[-1].rstrip("\n") + "  1.0\n", "PER BETA1 BETA2 I MOD PHA RE IM",
+            len(rows) + 1)                                                        # an extra field
+    bad = mean_rows([10.0], [0.0], [3], f8)
+    refused("b.8", "".join(rows + bad), "I", len(rows) + 1)                         # heave in a .8
+    msg = refused("c.9", "".join(rows[:-1]), "I", len(rows) - 1)                    # yaw missing at one period
+    assert "truncated" in msg
+    refused("d.9", "".join(rows[:3] + mean_rows([8.0], [30.0], [1, 2, 6], f8)), "PER BETA1 BETA2", 3)
+    refused("e.9", "".join(rows) + "rows end here\n", "PER BETA1 BETA2 I MOD PHA RE IM", len(rows) + 1)
+    refused("e.9", "".join(rows) + "a b c d e f g h\n", "PER", len(rows) + 1)       # text after the data
+    with pytest.raises(InputError, match="ulen"):
+        read_mean_drift(tmp_path / "c.9", None, RHO, G)
+    p = tmp_path / "g.9"
+    p.write_text("".join(mean_rows([10.0, 8.0], [0.0], [1, 2], f8)))
+    assert "[3, 4, 5, 6]" in read_mean_drift(p, ULEN, RHO, G).warnings[0]          # said, read as zero
+
+
+def test_wamit_mean_drift_keeps_bidirectional_rows_apart(tmp_path):
+    rows = mean_rows([10.0, 8.0], [0.0, 90.0], [1], f8)
+    rows += [wamit_line(per, 0.0, 90.0, 1, 0.5, 30.0, 0.5 * math.cos(math.pi / 6), 0.5 * math.sin(math.pi / 6))
+             for per in (10.0, 8.0)]
+    p = tmp_path / "bi.9"
+    p.write_text("".join(rows))
+    d = read_mean_drift(p, ULEN, RHO, G)
+    assert d.directions.tolist() == [0.0, 90.0] and set(d.cross) == {(0.0, 90.0)}
+    assert d.cross[(0.0, 90.0)][0, 0] == pytest.approx(0.5 * np.exp(1j * math.pi / 6) * RHO * G * ULEN, rel=1e-6)
+
+
+def hermitian_qtf(periods, seed=3):
+    """A smooth Hermitian non-dimensional QTF (n, n, 6) on the periods' frequencies; its
+    diagonal the mean drift, with negative entries in heave to exercise Newman's sign."""
+    w = 2 * np.pi / np.asarray(periods)
+    rng = np.random.default_rng(seed)
+    c = rng.normal(size=(6, 3)) + 1j * rng.normal(size=(6, 3))
+    wi, wj = w[:, None, None], w[None, :, None]
+    q = (c[:, 0] * (1 + 0.2 * (wi + wj)) + c[:, 1] * 0.3 * (wi - wj) + 0.1j * (wi - wj) * c[:, 2].real)
+    q = 0.5 * (q + np.conj(np.transpose(q, (1, 0, 2))))
+    return q
+
+
+def write_12d(path, periods, q, triangle="lower", skip=None, header=True):
+    """q (n, n, 6) nondimensional for heading 0 written as WAMIT's .12d: PER1 PER2 BETA1 BETA2
+    I Mod Pha Re Im, one triangle (or both)."""
+    lines = [HEADER.replace("test.8", path.name)] if header else []
+    n = len(periods)
+    for a in range(n):
+        for b in range(n):
+            if (triangle == "lower" and b > a) or (triangle == "upper" and b < a) or (a, b) == skip:
+                continue
+            for i in range(6):
+                v = q[a, b, i]
+                lines.append(wamit_line(periods[a], periods[b], 0.0, 0.0, i + 1, abs(v),
+                                        math.degrees(np.angle(v)), v.real, v.imag))
+    path.write_text("".join(lines))
+
+
+PERIODS = [12.0, 10.0, 8.0, 7.0, 6.0, 5.0]
+
+
+@pytest.mark.parametrize("triangle", ["lower", "upper", "both"])
+def test_wamit_12d_completes_the_triangle_by_conjugation(tmp_path, triangle):
+    q = hermitian_qtf(PERIODS)
+    p = tmp_path / "barge.12d"
+    write_12d(p, PERIODS, q, triangle)
+    d = read_qtf(p, ULEN, RHO, G)
+    scale = RHO * G * ULEN ** np.array([1, 1, 1, 2, 2, 2])
+    assert d.pairs == [(0.0, 0.0)] and np.allclose(d.omega, 2 * np.pi / np.array(PERIODS))
+    got = d.body("body1")[:, :, 0, :]
+    assert np.allclose(got, q * scale, rtol=1e-6, atol=1e-6 * np.abs(q * scale).max())
+    assert np.allclose(got, np.conj(np.transpose(got, (1, 0, 2))))        # Hermitian
+    m = read_mean_drift(p, ULEN, RHO, G)                                   # the diagonal is the mean drift
+    idx = np.arange(len(PERIODS))
+    assert np.allclose(m.body("body1")[:, 0, :], q[idx, idx].real * scale, rtol=1e-6)
+
+
+def test_wamit_12d_refuses_holes_and_mirrors_that_disagree(tmp_path):
+    q = hermitian_qtf(PERIODS)
+    p = tmp_path / "hole.12d"
+    write_12d(p, PERIODS, q, "lower", skip=(3, 1))
+    with pytest.raises(InputError, match="neither triangle.*PER1 = 10 s, PER2 = 7 s|neither triangle.*PER1 = 7 s"):
+        read_qtf(p, ULEN, RHO, G)
+    bad = q.copy()
+    bad[1, 3] = -bad[1, 3]          # written in both triangles, one is not the other's conjugate
+    p = tmp_path / "mirror.12d"
+    write_12d(p, PERIODS, bad, "both")
+    with pytest.raises(InputError, match="not the complex conjugate"):
+        read_qtf(p, ULEN, RHO, G)
+
+
+# ----------------------------------------------------------------------------- kernels
+
+def regular(a, w, beta=0.0, phase=0.0):
+    return Components(np.array([w]), np.array([a]), np.array([beta]), np.array([phase]))
+
+
+def test_held_body_in_a_regular_wave_feels_a_squared_q(tmp_path):
+    """The mean force of a regular wave = a²·Q(ω, ω)·ρgL^k, Q read from a .8 and interpolated
+    in frequency and heading (the hand interpolation in the test), with the ramp squared."""
+    path = tmp_path / "r.8"
+    path.write_text("".join(mean_rows([10.0, 8.0, 5.0], [0.0, 45.0], [1, 2, 6], f8)))
+    d = read_mean_drift(path, ULEN, RHO, G)
+    mean = MeanDrift(d.omega, d.directions, d.body("body1"))
+    a, per, beta = 1.3, 9.0, 30.0
+    w = 2 * np.pi / per
+    fw = (w - 2 * np.pi / 10) / (2 * np.pi / 8 - 2 * np.pi / 10)
+    for method in ("mean", "newman"):
+        load = DriftLoad(method, regular(a, w, beta, 0.4), mean)
+        for t in (25.0, 31.7):
+            f = load(phasors(regular(a, w, beta, 0.4), t, ramp_length=20.0))
+            for i, k in ((1, 1), (2, 1), (6, 2)):
+                q = [(1 - fw) * f8(10.0, b, i) + fw * f8(8.0, b, i) for b in (0.0, 45.0)]
+                want = a ** 2 * (q[0] + (q[1] - q[0]) * beta / 45) * RHO * G * ULEN ** k
+                assert f[i - 1] == pytest.approx(want, rel=1e-9)
+        half = load(phasors(regular(a, w, beta, 0.4), 10.0, ramp_length=20.0))
+        assert half == pytest.approx(0.25 * f, rel=1e-12)                   # r = ½ at half the ramp: r²
+
+
+def difference_component(t, f, mu):
+    """(mean, complex amplitude C) of f(t) ≈ mean + Re{C·e^{iμt}} (least squares)."""
+    m = np.column_stack((np.ones_like(t), np.cos(mu * t), -np.sin(mu * t)))
+    c = np.linalg.lstsq(m, f, rcond=None)[0]
+    return c[0], c[1] + 1j * c[2]
+
+
+def test_bichromatic_wave_difference_component_is_the_qtf_element():
+    """Two components: the slow load's component at ω1 − ω2 has the complex amplitude
+    2·a1·a2·Q(ω1, ω2)·e^{i(φ1 − φ2)} (full QTF) and 2·a1·a2·s·√(Q11·Q22) (Newman, s the common
+    sign; 0 when the signs differ); the mean is a1²Q11 + a2²Q22."""
+    w = 2 * np.pi / np.array(PERIODS)[::-1]
+    w = np.sort(w)
+    q = hermitian_qtf(PERIODS)[::-1, ::-1]
+    idx = np.arange(w.size)
+    q[idx, idx, 2] = np.array([1.0, 2.0, -1.5, 3.0, -0.5, 2.0])     # heave: signs to exercise Newman
+    data = QTF(w, [(0.0, 0.0)], q[:, :, None, :])
+    w1, w2 = w[3], w[1]                          # on the grid: Q exact
+    a1, a2, p1, p2 = 0.8, 1.1, 0.3, 2.0
+    comps = Components(np.array([w1, w2]), np.array([a1, a2]), np.zeros(2), np.array([p1, p2]))
+    t = np.linspace(0, 4 * 2 * np.pi / (w1 - w2), 801)
+    full, newman = DriftLoad("qtf", comps, data), DriftLoad("newman", comps, data)
+    ff = np.array([full(phasors(comps, s)) for s in t])
+    fn = np.array([newman(phasors(comps, s)) for s in t])
+    for dof in range(6):
+        q11, q22, q12 = q[3, 3, dof].real, q[1, 1, dof].real, q[3, 1, dof]
+        m, c = difference_component(t, ff[:, dof], w1 - w2)
+        assert m == pytest.approx(a1 ** 2 * q11 + a2 ** 2 * q22, rel=1e-9, abs=1e-12)
+        assert abs(c - 2 * a1 * a2 * q12 * np.exp(1j * (p1 - p2))) < 1e-9 * abs(q12) * a1 * a2
+        m, c = difference_component(t, fn[:, dof], w1 - w2)
+        s = np.sign(q11) if np.sign(q11) == np.sign(q22) else 0.0
+        want = 2 * a1 * a2 * s * math.sqrt(abs(q11 * q22)) * np.exp(1j * (p1 - p2))
+        assert m == pytest.approx(a1 ** 2 * q11 + a2 ** 2 * q22, rel=1e-9, abs=1e-12)
+        assert abs(c - want) < 1e-9 * math.sqrt(abs(q11 * q22)) * a1 * a2 + 1e-12
+
+
+def test_qtf_interpolation_cutoff_and_spreading_refusal():
+    """Off the grid the QTF is the bilinear interpolation in (ω_i, ω_j) (computed here by
+    hand); pairs beyond the cut-off are left out; a unidirectional QTF in a spread sea is
+    refused, Newman and mean accept it."""
+    w = np.linspace(0.4, 1.4, 6)
+    q = hermitian_qtf(2 * np.pi / w)
+    data = QTF(w, [(0.0, 0.0)], q[:, :, None, :])
+    wi, wj = 0.55, 1.03
+    i, j = 0, 3            # 0.4 ≤ 0.55 < 0.6, 1.0 ≤ 1.03 < 1.2
+    fi, fj = (wi - w[i]) / (w[1] - w[0]), (wj - w[j]) / (w[1] - w[0])
+    hand = ((1 - fi) * (1 - fj) * q[i, j] + fi * (1 - fj) * q[i + 1, j] + (1 - fi) * fj * q[i, j + 1]
+            + fi * fj * q[i + 1, j + 1])
+    assert np.allclose(data.at([wi], [wj], 0.0, 0.0)[0], hand)
+    comps = Components(np.array([0.5, 0.6, 1.2]), np.array([1.0, 0.7, 0.4]), np.zeros(3), np.array([0.0, 1.0, 2.0]))
+    z = phasors(comps, 12.3)
+    cut = DriftLoad("qtf", comps, data, cutoff=0.15)
+    qq = data.at(np.repeat(comps.omega, 3), np.tile(comps.omega, 3), 0.0, 0.0).reshape(3, 3, 6)
+    keep = np.abs(comps.omega[:, None] - comps.omega[None, :]) <= 0.15
+    want = sum((qq[a, b] * z[a] * np.conj(z[b])).real for a in range(3) for b in range(3) if keep[a, b])
+    assert np.allclose(cut(z), want, rtol=1e-12, atol=1e-12)
+    spread = Components(comps.omega, comps.amplitude, np.array([0.0, 10.0, -5.0]), comps.phase)
+    with pytest.raises(WaveError, match="bidirectional"):
+        DriftLoad("qtf", spread, QTF(w, [(-10.0, -10.0), (0.0, 0.0), (20.0, 20.0)],
+                                     np.repeat(q[:, :, None, :], 3, axis=2)))
+    DriftLoad("newman", spread, QTF(w, [(-10.0, -10.0), (20.0, 20.0)], np.repeat(q[:, :, None, :], 2, axis=2)))
