@@ -239,3 +239,189 @@ def test_qtf_interpolation_cutoff_and_spreading_refusal():
         DriftLoad("qtf", spread, QTF(w, [(-10.0, -10.0), (0.0, 0.0), (20.0, 20.0)],
                                      np.repeat(q[:, :, None, :], 3, axis=2)))
     DriftLoad("newman", spread, QTF(w, [(-10.0, -10.0), (20.0, 20.0)], np.repeat(q[:, :, None, :], 2, axis=2)))
+
+
+# ------------------------------------------------------------------- irregular sea (Pinkster)
+
+W_LO, W_HI = 0.2, 2.4
+
+
+def smooth_qtf():
+    """A surge QTF [N/m²] on a fine grid: Q(ω1, ω2) = 8e3·(1 + 0.4·(ω1 + ω2)) + 2e3i·(ω1 − ω2)
+    (Hermitian, its diagonal positive and rising like a wall's drift), other dofs 0."""
+    w = np.linspace(W_LO, W_HI, 45)
+    q = np.zeros((w.size, w.size, 1, 6), complex)
+    q[:, :, 0, 0] = 8e3 * (1 + 0.4 * (w[:, None] + w[None, :])) + 2e3j * (w[:, None] - w[None, :])
+    return w, q
+
+
+def q_surge(w1, w2):
+    return 8e3 * (1 + 0.4 * (w1 + w2)) + 2e3j * (w1 - w2)
+
+
+SEA = SeaState("jonswap", hs=2.0, tp=9.0, gamma=3.3, components=200, seed=7)
+DT, NSTEP, CUTOFF = 3.0, 2 ** 15 // 3, 0.9      # 9.1 h sampled above the cut-off's Nyquist rate
+
+
+@pytest.fixture(scope="module")
+def drift_record():
+    """The surge drift force of a JONSWAP sea (200 components, full QTF to |ω_i − ω_j| ≤ 0.9
+    rad/s) sampled every 3 s for 9.1 h, and its sea's components."""
+    w, q = smooth_qtf()
+    comps = components(SEA, (W_LO, W_HI))
+    load = DriftLoad("qtf", comps, QTF(w, [(0.0, 0.0)], q), cutoff=CUTOFF)
+    t = np.arange(NSTEP) * DT
+    f = np.array([load(phasors(comps, s))[0] for s in t])
+    return t, f, comps
+
+
+def continuous_slow_drift(mu):
+    """Pinkster's one-sided slow-drift spectrum S_F(μ) = 8∫S(ω)S(ω+μ)|Q(ω, ω+μ)|²dω [N²·s/rad]."""
+    w = np.linspace(0.05, 4.0, 3000)
+    mu = np.atleast_1d(mu)[:, None]
+    s = spectrum(w, SEA.hs, SEA.tp, SEA.gamma)[None, :]
+    s2 = spectrum((w + mu).ravel(), SEA.hs, SEA.tp, SEA.gamma).reshape(mu.size, w.size)
+    return 8 * np.trapezoid(s * s2 * np.abs(q_surge(w[None, :], w + mu)) ** 2, w, axis=1)
+
+
+def test_irregular_sea_mean_drift_is_twice_the_integral_of_s_q(drift_record):
+    """Time mean = 2∫S(ω)Q(ω, ω)dω within the spread of a record of length T: the sample mean
+    of a process with one-sided spectrum S_F has the variance ≈ π·S_F(0)/T."""
+    t, f, comps = drift_record
+    w = np.linspace(0.05, 4.0, 8000)
+    s = spectrum(w, SEA.hs, SEA.tp, SEA.gamma)
+    mean = 2 * np.trapezoid(s * q_surge(w, w).real, w)
+    discrete = np.sum(comps.amplitude ** 2 * q_surge(comps.omega, comps.omega).real)
+    assert discrete == pytest.approx(mean, rel=0.01)             # 100 components, 0.5 % of the energy left out
+    sigma = math.sqrt(math.pi * continuous_slow_drift(0.0)[0] / (t[-1] + DT))
+    assert abs(f.mean() - mean) < 4 * sigma + 0.01 * mean, (f.mean(), mean, sigma)
+    assert sigma < 0.1 * mean                                   # the test can fail
+
+
+def test_irregular_sea_slow_drift_spectrum_is_pinkster_s_s_q2(drift_record):
+    """Welch spectrum of the record against 8∫S(ω)S(ω+μ)|Q(ω, ω+μ)|²dω in bands of 0.1 rad/s,
+    each within 3 times its spread: the Welch estimate's (1/√(segments × bins)) and the
+    discrete sea's (a band holds M difference lines of unequal power: √Σp²/Σp)."""
+    from scipy.signal import welch
+    t, f, comps = drift_record
+    fs = 1 / DT
+    freq, p = welch(f - f.mean(), fs=fs, nperseg=2048)
+    mu, s_f = 2 * np.pi * freq, p / (2 * np.pi)                  # per rad/s
+    w, a = comps.omega, comps.amplitude
+    i, j = np.triu_indices(w.size, 1)
+    line_mu = np.abs(w[j] - w[i])       # (the bands below stay under the cut-off)
+    line_p = 2 * a[i] ** 2 * a[j] ** 2 * np.abs(q_surge(w[i], w[j])) ** 2
+    checked = 0
+    for lo in np.arange(0.05, 0.85, 0.1):
+        hi = lo + 0.1
+        sel = (mu >= lo) & (mu < hi)
+        measured = np.trapezoid(s_f[sel], mu[sel]) / (mu[sel][-1] - mu[sel][0])
+        grid = np.linspace(lo, hi, 21)
+        theory = np.trapezoid(continuous_slow_drift(grid), grid) / (hi - lo)
+        lines = (line_mu >= lo) & (line_mu < hi)
+        spread = math.sqrt(1 / (sel.sum() * 2 * NSTEP / 2048) + np.sum(line_p[lines] ** 2) / np.sum(line_p[lines]) ** 2)
+        assert abs(measured / theory - 1) < 3 * spread, (lo, measured, theory, spread)
+        assert spread < 0.15
+        checked += 1
+    assert checked == 8
+
+
+def test_moored_body_slow_drift_resonance(drift_record):
+    """A moored body (surge stiffness k, natural period 100 s, 10 % of critical damping) driven
+    by the drift record (scipy's lsim, exact for the record's linear interpolation): mean
+    offset = F̄/k; slow-drift std = √∫|H(μ)|²S_F(μ)dμ of Pinkster's spectrum, within the
+    spread of the discrete sea's lines near the resonance and of the record's length."""
+    from scipy.signal import lsim
+    t, f, comps = drift_record
+    mass, period, zeta = 2.0e6, 100.0, 0.1
+    wn = 2 * math.pi / period
+    k, c = mass * wn ** 2, 2 * zeta * mass * wn
+    _, x, _ = lsim(([1.0], [mass, c, k]), f, t)
+    settle = t > 10 / (zeta * wn)                              # e^-10 of the start left
+    mean_f = 2 * np.trapezoid(spectrum(np.linspace(0.05, 4, 8000), SEA.hs, SEA.tp, SEA.gamma)
+                              * q_surge(np.linspace(0.05, 4, 8000), np.linspace(0.05, 4, 8000)).real,
+                              np.linspace(0.05, 4, 8000))
+    sigma = math.sqrt(math.pi * continuous_slow_drift(0.0)[0] / (settle.sum() * DT))
+    assert abs(x[settle].mean() - mean_f / k) < (4 * sigma + 0.01 * mean_f) / k, (x[settle].mean(), mean_f / k)
+    mu = np.linspace(1e-4, CUTOFF, 3000)
+    h2 = 1 / ((k - mass * mu ** 2) ** 2 + (c * mu) ** 2)
+    std_fd = math.sqrt(np.trapezoid(h2 * continuous_slow_drift(mu), mu))
+    w, a = comps.omega, comps.amplitude
+    i, j = np.triu_indices(w.size, 1)
+    lm = np.abs(w[j] - w[i])
+    i, j, lm = i[lm <= CUTOFF], j[lm <= CUTOFF], lm[lm <= CUTOFF]
+    power = 2 * a[i] ** 2 * a[j] ** 2 * np.abs(q_surge(w[i], w[j])) ** 2 / ((k - mass * lm ** 2) ** 2 + (c * lm) ** 2)
+    lines = math.sqrt(np.sum(power ** 2)) / np.sum(power)      # the discrete sea's spread of the variance
+    record = math.sqrt(1 / (zeta * wn * settle.sum() * DT))    # a variance from T/(decay time) independent pieces
+    spread = 0.5 * math.sqrt(lines ** 2 + record ** 2)          # of the std: half the variance's
+    assert abs(x[settle].std() / std_fd - 1) < 3 * spread, (x[settle].std(), std_fd, spread)
+    assert spread < 0.1
+
+
+# ------------------------------------------------------------- Capytaine far-field mean drift
+
+DATA = __import__("pathlib").Path(__file__).parent / "data" / "bem"
+
+
+def bottom_mounted_cylinder_drift(ka):
+    """F̄/(ρ·g·A²·a) of a bottom-mounted vertical cylinder in deep water (MacCamy–Fuchs
+    diffraction): 4/(π²(ka)³)·Σ_{n≥0}[1 − n(n+1)/(ka)²]²/(|H'_n(ka)|²·|H'_{n+1}(ka)|²)."""
+    from scipy.special import h1vp
+    n = np.arange(40)
+    return 4 / (math.pi ** 2 * ka ** 3) * np.sum((1 - n * (n + 1) / ka ** 2) ** 2
+                                                 / (np.abs(h1vp(n, ka)) ** 2 * np.abs(h1vp(n + 1, ka)) ** 2))
+
+
+def test_closed_form_of_the_cylinder_drift():
+    """The series gives the published values (0.2860 … at ka = 0.5 …)."""
+    for ka, want in ((0.5, 0.2860), (0.75, 0.5717), (1.0, 0.6649), (1.5, 0.6004), (2.0, 0.6272)):
+        assert bottom_mounted_cylinder_drift(ka) == pytest.approx(want, abs=6e-5)
+
+
+def test_capytaine_far_field_drift_of_a_deep_draught_cylinder():
+    """drift_cylinder.nc (tests/data/bem/make_drift_data.py: a held cylinder a = 1 m, T = 6 m,
+    2112 panels, `hydrofmu meandrift --fixed`) read as Q(ω, ω; 0, 0): surge within 4.5 % of
+    the bottom-mounted closed form at ka = 0.5…2 (the mesh's accuracy: +3.9, +4.0, +3.2, +2.1,
+    +1.5 %), sway and yaw below 1e-3 of it (symmetry); a regular wave then feels a²·Q."""
+    d = read_mean_drift(DATA / "drift_cylinder.nc")
+    assert d.kind == "Capytaine" and d.dofs == [("cyl", 1), ("cyl", 2), ("cyl", 6)] and d.directions.tolist() == [0.0]
+    q = d.body("cyl")[:, 0, :]
+    ka = d.omega ** 2 / 9.81          # a = 1 m, deep water
+    assert np.allclose(ka, [0.5, 0.75, 1.0, 1.5, 2.0])
+    rho_g = d.rho * d.g
+    for k, row in zip(ka, q):
+        ref = bottom_mounted_cylinder_drift(k) * rho_g
+        assert row[0] == pytest.approx(ref, rel=0.045)
+        assert abs(row[1]) < 1e-3 * ref and abs(row[5]) < 1e-3 * ref
+    load = DriftLoad("mean", regular(0.7, d.omega[2]), MeanDrift(d.omega, d.directions, d.body("cyl")))
+    assert load(phasors(regular(0.7, d.omega[2]), 100.0))[0] == pytest.approx(0.49 * q[2, 0], rel=1e-12)
+
+
+def test_meandrift_regenerates_the_cylinder_drift(tmp_path):
+    """`hydrofmu meandrift --fixed` on the cylinder's mesh (written as a WAMIT .gdf) and the
+    file's own diffraction data at ka = 1 (the drift taken out) finds the file's drift; a mesh
+    that is not the dataset's is refused by the excitation check, nothing written (needs
+    capytaine: the bem-solve extra, installed in CI)."""
+    pytest.importorskip("capytaine")
+    import importlib.util
+
+    import capytaine as cpt
+    import xarray as xr
+    from hydrofmu.cli import main
+    spec = importlib.util.spec_from_file_location("make_drift_data", DATA / "make_drift_data.py")
+    make = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make)
+    gdf, user, out = tmp_path / "cyl.gdf", tmp_path / "user.nc", tmp_path / "drift.nc"
+    make.write_gdf(cpt.mesh_vertical_cylinder(length=2 * make.DRAUGHT, radius=make.RADIUS, center=(0, 0, 0),
+                                              resolution=make.RESOLUTION), gdf)
+    ds = xr.load_dataset(DATA / "drift_cylinder.nc")
+    ds.drop_vars([v for v in ds.data_vars if v.startswith("drift_force")]).isel(omega=[2]).to_netcdf(user)
+    assert main(["meandrift", str(user), "--mesh", str(gdf), "-o", str(out), "--fixed"]) == 0
+    got = read_mean_drift(out).body("cyl")[0, 0]
+    want = read_mean_drift(DATA / "drift_cylinder.nc").body("cyl")[2, 0]
+    assert got[0] == pytest.approx(want[0], rel=1e-6)
+    wide = tmp_path / "wide.gdf"
+    make.write_gdf(cpt.mesh_vertical_cylinder(length=2 * make.DRAUGHT, radius=1.2, center=(0, 0, 0),
+                                              resolution=(2, 16, 12)), wide)
+    assert main(["meandrift", str(user), "--mesh", str(wide), "-o", str(tmp_path / "no.nc"), "--fixed"]) == 2
+    assert not (tmp_path / "no.nc").exists()

@@ -38,13 +38,15 @@ naming both lines; a dof given at some (periods, headings) and missing at others
 error (a truncated file); a dof missing at every one is zero (WAMIT leaves out what it does
 not compute), said in ``warnings``.
 
-Capytaine (needs the `bem` extra): a dataset as ``cpt.export_dataset`` writes it with a
-variable ``mean_drift_force`` over (omega, wave_direction [rad], influenced_dof), as
-``cpt.post_pro.far_field_mean_drift_force`` computes it (``hydrofmu drift2nc`` adds it to a
-user's dataset).  That function returns the mean force on the body per unit wave amplitude
-squared, N/m², for the wave of amplitude 1 (Capytaine's e^{−iωt}: the mean of a product of
-two first-order quantities is the same in either time convention, no conjugation), dofs
-Surge, Sway (and Yaw when asked); it is a² Q(ω, ω; β, β) with a = 1, read as written.
+Capytaine (needs the `bem` extra): a dataset as ``cpt.export_dataset`` writes it holding
+``cpt.post_pro.far_field_mean_drift_force``'s result as it returns it (``hydrofmu meandrift``
+adds it to a user's dataset): ``drift_force_surge``, ``drift_force_sway``, ``drift_force_yaw``
+over (omega, wave_direction_k, wave_direction_l) [rad], complex, per unit wave amplitude
+squared (N/m², N·m/m²: the function leaves the amplitude out).  Its diagonal
+(wave_direction_k = wave_direction_l) is the mean drift of a unidirectional wave, real (a
+mean of products of first-order quantities: the same in Capytaine's e^{−iωt} and our
+e^{+iωt}, no conjugation), read as Q(ω, ω; β, β) for dofs 1, 2, 6; the bidirectional
+entries are not read (said in ``warnings``); ω = 0 and ∞ rows are dropped.
 """
 from __future__ import annotations
 
@@ -138,7 +140,7 @@ class QTFData:
 def read_mean_drift(path, ulen=None, rho=None, g=None) -> MeanDriftData:
     """Mean drift of a WAMIT .7/.8/.9 file (``ulen`` [m], ``rho``, ``g`` make it dimensional),
     a WAMIT .10d/.11d/.12d (its diagonal) or a Capytaine dataset (.nc) holding
-    ``mean_drift_force``."""
+    ``drift_force_surge``, ``drift_force_sway``, ``drift_force_yaw`` (``hydrofmu meandrift``)."""
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
         return _capytaine_mean(path)
@@ -148,7 +150,7 @@ def read_mean_drift(path, ulen=None, rho=None, g=None) -> MeanDriftData:
         return read_qtf(path, ulen, rho, g).mean()
     raise InputError(path, None, "bem", "expected a WAMIT mean drift file (.7 control surface, .8 momentum, "
                                         ".9 pressure), a WAMIT QTF (.10d/.11d/.12d) or a Capytaine dataset (.nc) "
-                                        "with mean_drift_force")
+                                        "with drift_force_surge/sway/yaw (hydrofmu meandrift)")
 
 
 def read_qtf(path, ulen=None, rho=None, g=None) -> QTFData:
@@ -382,39 +384,55 @@ def _wamit_qtf(path, ulen, rho, g):
 
 # ---------------------------------------------------------------------------- Capytaine
 
+CAPYTAINE_DRIFT = {"drift_force_surge": 1, "drift_force_sway": 2, "drift_force_yaw": 6}
+
+
 def _capytaine_mean(path):
-    from .bem_waves import _centres, _dof, _open, _scalar
+    from .bem_waves import _centres, _complex, _open, _scalar
     ds = _open(path)
-    name = "mean_drift_force"
-    if name not in ds:
-        raise InputError(path, None, name, "missing: add the far-field mean drift to the dataset with "
-                                           "`hydrofmu drift2nc` (Capytaine's post_pro.far_field_mean_drift_force)")
-    var = ds[name]
-    if "complex" in var.dims:
-        raise InputError(path, None, name, "expected real values (the mean drift), found a 'complex' dimension")
-    want = ("omega", "wave_direction", "influenced_dof")
-    if sorted(var.dims) != sorted(want):
-        raise InputError(path, None, name, f"expected dimensions {want}, found {tuple(var.dims)}")
-    q = np.moveaxis(var.values.astype(float), [var.dims.index(d) for d in want], [0, 1, 2])
+    names = [n for n in CAPYTAINE_DRIFT if n in ds]
+    if not names:
+        raise InputError(path, None, "drift_force_surge", "missing: add the far-field mean drift to the dataset with "
+                                                          "`hydrofmu meandrift` (Capytaine's "
+                                                          "post_pro.far_field_mean_drift_force)")
+    want = ("omega", "wave_direction_k", "wave_direction_l")
     omega = ds["omega"].values.astype(float)
     keep = np.isfinite(omega) & (omega > 0)
-    omega, q = omega[keep], q[keep]
-    order = np.argsort(omega)
-    omega, q = omega[order], q[order]
-    if omega.size < 2 or np.any(np.diff(omega) <= 0):
-        raise InputError(path, None, "omega", "at least two distinct finite frequencies needed for the mean drift")
-    rad = np.atleast_1d(ds["wave_direction"].values.astype(float))
+    order = np.argsort(omega[keep])
+    rad = np.atleast_1d(ds["wave_direction_k"].values.astype(float))
+    if rad.tolist() != np.atleast_1d(ds["wave_direction_l"].values.astype(float)).tolist():
+        raise InputError(path, None, "wave_direction_l", "expected the same headings as wave_direction_k")
     if np.any(np.abs(rad) > 2 * np.pi + 1e-9):
-        raise InputError(path, None, "wave_direction", f"{rad[np.argmax(np.abs(rad))]:g} is beyond ±2π: Capytaine "
-                                                       "gives directions in radians")
-    names = [str(n) for n in np.atleast_1d(ds["influenced_dof"].values)]
-    dofs = [_dof(path, n, ds, "influenced_dof") for n in names]
-    bad = ~np.isfinite(q)
-    if bad.any():
-        i, j, k = np.argwhere(bad)[0]
-        raise InputError(path, None, name, f"{bad.sum()} non-finite value(s), first at omega={omega[i]:g} rad/s, "
-                                           f"wave_direction={np.degrees(rad[j]):g}°, influenced_dof={names[k]}")
+        raise InputError(path, None, "wave_direction_k", f"{rad[np.argmax(np.abs(rad))]:g} is beyond ±2π: Capytaine "
+                                                         "gives directions in radians")
+    idx = np.arange(rad.size)
+    values, warnings = [], []
+    for name in names:
+        var = ds[name]
+        dims = [d for d in var.dims if d != "complex"]
+        if sorted(dims) != sorted(want):
+            raise InputError(path, None, name, f"expected dimensions {want}, found {tuple(dims)}")
+        q = np.moveaxis(_complex(var, path), [dims.index(d) for d in want], [0, 1, 2])[keep][order]
+        diag = q[:, idx, idx]
+        bad = ~np.isfinite(diag)
+        if bad.any():
+            i, j = np.argwhere(bad)[0]
+            raise InputError(path, None, name, f"{bad.sum()} non-finite value(s) on the diagonal, first at omega="
+                                               f"{omega[keep][order][i]:g} rad/s, wave_direction={np.degrees(rad[j]):g}°")
+        if np.any(np.abs(diag.imag) > REAL_RTOL * np.abs(diag) + 1e-9 * max(np.abs(diag).max(), 1.0)):
+            raise InputError(path, None, name, "the diagonal (wave_direction_k = wave_direction_l) is the mean drift, "
+                                               "real; found imaginary parts")
+        values.append(diag.real)
+        if rad.size > 1:
+            warnings.append(f"{path}: {name}: the bidirectional entries (wave_direction_k ≠ wave_direction_l) are not "
+                            f"read (the mean drift of a sea uses the diagonal)")
+    omega = omega[keep][order]
+    if omega.size < 1:
+        raise InputError(path, None, "omega", "no finite frequency: no mean drift")
+    dofs = [("body" if "body" not in ds.coords else str(np.atleast_1d(ds["body"].values)[0]), CAPYTAINE_DRIFT[n])
+            for n in names]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
-    return MeanDriftData(str(path), "Capytaine", omega, np.degrees(rad), q, dofs, bodies,
+    return MeanDriftData(str(path), "Capytaine", omega, np.degrees(rad), np.stack(values, axis=-1), dofs, bodies,
                          rotation_centers=_centres(ds, bodies), rho=_scalar(ds, "rho", path),
-                         g=_scalar(ds, "g", path), water_depth=_scalar(ds, "water_depth", path))
+                         g=_scalar(ds, "g", path), water_depth=_scalar(ds, "water_depth", path),
+                         warnings=warnings[:1])

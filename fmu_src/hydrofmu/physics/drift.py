@@ -240,7 +240,8 @@ class DriftLoad:
                 band[i[keep], off] = qtf.at(w[i[keep]], w[j[keep]], beta[i[keep]], beta[j[keep]])
         band[:, 1:] *= 2.0                                    # the pair (j, i) is the conjugate: 2·Re
         flat = band.reshape(-1, 6)
-        self.band_re, self.band_im = flat.real.copy(), flat.imag.copy()
+        self.table = np.empty((2 * flat.shape[0], 6))          # rows [Re Q; −Im Q] interleaved like a complex
+        self.table[0::2], self.table[1::2] = flat.real, -flat.imag   # array's floats: Re(p·Q) in one product
         self.offsets = d
         self._pad = np.zeros(n + d, complex)
 
@@ -255,5 +256,4 @@ class DriftLoad:
         n, d = self.n, self.offsets
         self._pad[:n] = np.conj(z)
         pairs = z[:, None] * np.lib.stride_tricks.sliding_window_view(self._pad, d + 1)   # [i, off] z_i·conj(z_{i+off})
-        pairs = pairs.ravel()
-        return pairs.real @ self.band_re - pairs.imag @ self.band_im
+        return np.ascontiguousarray(pairs).ravel().view(np.float64) @ self.table
