@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 from . import scene as _scene
 from .errors import InputError
 from .scene import Scene
+from .scene.files import files_named
 
 if TYPE_CHECKING:
     from .cosim.result import Result
@@ -88,32 +89,6 @@ def build(scene: str | Path | Scene, out: str | Path = DEFAULT_OUT, *,
     return Path(build_scene(scene, Path(out), log=log, inputs=inputs, runtime=runtime))
 
 
-def _files_named(value, base):
-    """Existing files that string values of a TOML document name (relative to ``base``)."""
-    if isinstance(value, dict):
-        value = list(value.values())
-    if isinstance(value, list):
-        return [f for v in value for f in _files_named(v, base)]
-    if isinstance(value, str) and value:
-        try:
-            f = (base / value).resolve()
-            return [f] if f.is_file() else []
-        except (OSError, ValueError):
-            return []
-    return []
-
-
-def scene_files(path: str | Path) -> list[Path]:
-    """The existing files a scene file's values name (decks, BEM results, current files),
-    resolved; [] when it cannot be read as TOML."""
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        return []
-    return sorted(set(_files_named(doc, path.resolve().parent)))
-
-
 def inputs_hash(path: str | Path) -> str | None:
     """What a build of the scene file ``path`` depends on, as one hash: the scene's bytes,
     every file its values name (decks, BEM results, current files: any string that is a
@@ -127,7 +102,7 @@ def inputs_hash(path: str | Path) -> str | None:
         return None
     h = hashlib.sha256(sys.version.encode())
     h.update(data)
-    for f in sorted(set(_files_named(doc, path.resolve().parent))):
+    for f in sorted(set(files_named(doc, path.resolve().parent))):
         h.update(str(f).encode())
         h.update(f.read_bytes())
     for f in sorted(PACKAGE.rglob("*")):

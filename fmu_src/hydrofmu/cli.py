@@ -8,7 +8,8 @@ import warnings
 import zipfile
 from pathlib import Path
 
-from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs, scene_files
+from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
+from .scene.files import scene_files
 from .cosim.manifest import read_manifest
 from .cosim.master import check_steps, describe
 from .errors import InputError, InputWarning

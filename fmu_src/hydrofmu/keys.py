@@ -1,6 +1,6 @@
 """The keys of scene files and case files: every table, its keys, each key's type and meaning.
 
-This is the one place that defines them.  ``scene.py`` and ``batch.py`` accept exactly these
+This is the one place that defines them.  the scene package and ``batch.py`` accept exactly these
 keys (an unknown one is an error naming the closest, `scene.Problems.known_keys`), and
 ``schema.py`` turns them into the JSON Schema shipped with the package
 (``hydrofmu/schema/scene.schema.json``, ``cases.schema.json``), which TOML editors (taplo,

@@ -340,7 +340,7 @@ def check_target(scene, target):
     """A build replaces ``target`` (OUT/<scene name>) whole: refuse when that would delete
     what is not a build (a folder without manifest.json holding files, e.g. the scene's
     decks) or the scene's own files (a deck kept inside its build folder)."""
-    from ..api import scene_files
+    from ..scene.files import scene_files
     target = Path(target)
     if target.exists() and not target.is_dir():
         raise InputError(target, None, "output folder", "is a file, where the build's folder goes")

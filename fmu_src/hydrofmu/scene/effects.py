@@ -1,0 +1,170 @@
+"""The effect tables of a body (``[[bodies.NAME.effects]]``): each validator turns its table
+into kernel data, from inline values or a vendor deck (RIFLEX BODY/CONB lumped data too)."""
+import numpy as np
+
+from .. import admissible, keys
+from ..errors import InputError
+from .problems import deck_path, from_deck
+
+
+def _aqwa_viscous_drag(problems, table, where):
+    from ..decks.aqwa import read_viscous_drag
+    if "deck" in table:
+        problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", True))
+        data, _ = from_deck(problems, table, where, read_viscous_drag, "body")
+        if data is None:
+            return None
+        return {"matrix": np.asarray(data.matrix).tolist(), "relative": data.option == "RELATIVE"}
+    problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", False))
+    matrix = problems.matrix(table, "matrix", f"{where}.matrix", 6)
+    option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
+    if matrix is None or option is None:
+        return None
+    for k, message in admissible.negative_diagonal(matrix):
+        problems.warn(f"{where}.matrix[{k + 1},{k + 1}]", message)
+    return {"matrix": matrix, "relative": option == "RELATIVE"}
+
+
+def _deeplines_current_polar(problems, table, where):
+    from ..decks.deeplines import CurrentPolarData, read_current_polars
+    from ..physics.current_polar import expand_polar
+    symmetry = problems.choice(table, "symmetry", f"{where}.symmetry", ("none", "xz", "yz", "xz+yz"), "none")
+    if "deck" in table:
+        problems.known_keys(table, where, keys.effect_keys("deeplines_current_polar", True))
+        data, _ = from_deck(problems, table, where, read_current_polars, "structure")
+    else:
+        problems.known_keys(table, where, keys.effect_keys("deeplines_current_polar", False))
+        point = problems.vector(table, "point", f"{where}.point", 3)
+        surface = problems.number(table, "surface", f"{where}.surface", positive=True)
+        raw = table.get("table")
+        arr = problems.array(raw, f"{where}.table") if raw is not None else None
+        if raw is None:
+            problems.add(f"{where}.table", "missing table of [angle, CX, CY, CMZ] rows")
+        elif arr is not None and (arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 2):
+            problems.add(f"{where}.table", f"expected rows of 4 numbers [angle, CX, CY, CMZ], found shape {list(arr.shape)}")
+            arr = None
+        if point is None or surface is None or arr is None:
+            return None
+        data = CurrentPolarData(name=table.get("name", "polar"), xc=point[0], yc=point[1], zc=point[2],
+                                surfc=surface, angles=arr[:, 0], cx=arr[:, 1], cy=arr[:, 2], cmz=arr[:, 3],
+                                path=str(problems.path), line=None)
+    if data is None or symmetry is None:
+        return None
+    try:
+        angles, cx, cy, cmz = expand_polar(data, symmetry)
+    except InputError as exc:
+        if "deck" in table:
+            problems.add(f"{where}.symmetry", str(exc))   # names the deck's file and line
+        else:   # an inline table: the key at fault, the column in the message
+            key = "symmetry" if "symmetry" in exc.message else "table"
+            problems.add(f"{where}.{key}", f"{exc.field}: {exc.message}")
+        return None
+    return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
+            "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
+
+
+LUMPED_KEYS = keys.names(keys.LUMPED)
+
+
+def lumped_data(problems, table, where, kind):
+    """RIFLEX lumped properties (AM, AE, ICOO, CD, added mass) from a deck component or
+    inline; ``kind`` is 'BODY' or 'CONB'.  Returns (data dict, conb codes or None)."""
+    from ..decks.riflex import BodyData, ConbData, read_components
+    if "deck" in table:
+        comp, path = from_deck(problems, table, where, read_components, "component", units=True)
+        if comp is None:
+            return None, None
+        want = BodyData if kind == "BODY" else ConbData
+        if not isinstance(comp, want):
+            problems.add(f"{where}.component", f"{table['component']!r} in {path.name} is not a "
+                                               f"NEW COMPonent {kind} data group")
+            return None, None
+        data = {"am": comp.am, "ae": comp.ae, "icoo": comp.icoo, "cd": list(comp.cd),
+                "added_mass": list(comp.added_mass)}
+        return data, (list(comp.codes) if kind == "CONB" else None)
+    data = {
+        "am": problems.number(table, "am", f"{where}.am", 0.0, nonneg=True),
+        "ae": problems.number(table, "ae", f"{where}.ae", 0.0, nonneg=True),
+        "icoo": problems.choice(table, "icoo", f"{where}.icoo", ("GLOBAL", "LOCAL"), "GLOBAL"),
+        "cd": problems.vector(table, "cd", f"{where}.cd", 3, [0.0] * 3),
+        "added_mass": problems.vector(table, "added_mass", f"{where}.added_mass", 3, [0.0] * 3),
+    }
+    codes = None
+    if kind == "CONB":
+        codes = problems.vector(table, "codes", f"{where}.codes", 3, [0, 0, 0])
+        if codes is not None and any(c not in (0, 1) for c in codes):
+            problems.add(f"{where}.codes", f"freedom codes IRX IRY IRZ must be 0 (free) or 1 (fixed), found {codes}")
+            codes = None
+    if any(v is None for v in data.values()) or (kind == "CONB" and codes is None):
+        return None, None
+    return data, ([int(c) for c in codes] if codes is not None else None)
+
+
+def _riflex_body(problems, table, where):
+    problems.known_keys(table, where, keys.effect_keys("riflex_body", "deck" in table))
+    offset = problems.vector(table, "offset", f"{where}.offset", 3)
+    data, _ = lumped_data(problems, table, where, "BODY")
+    if data is None or offset is None:
+        return None
+    return {**data, "offset": offset}
+
+
+def _bem_entry(problems, table, where, reader):
+    """(data read by ``reader``, file, BEM body name) of a BEM wave effect entry (keys bem,
+    body, ulen), or (None, None, None) after recording the problem."""
+    path = deck_path(problems, table, where, "bem")
+    ulen = problems.number(table, "ulen", f"{where}.ulen", positive=True) if "ulen" in table else None
+    body = problems.string(table, "body", f"{where}.body") if "body" in table else None
+    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None):
+        return None, None, None
+    env = getattr(problems, "env", {})
+    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81))
+    if data is None:
+        return None, None, None
+    if body is None:
+        if len(data.bodies) != 1:
+            problems.add(f"{where}.body", f"{path.name} holds {len(data.bodies)} bodies ({', '.join(data.bodies)}): "
+                                          "name one")
+            return None, None, None
+        body = data.bodies[0]
+    if body not in data.bodies:
+        problems.add(f"{where}.body", f"{body!r} is not a body of {path.name} (it has: {', '.join(data.bodies)})")
+        return None, None, None
+    return data, path, body
+
+
+def _wave_excitation(problems, table, where):
+    """First-order wave excitation from a BEM result (Capytaine .nc, WAMIT .3 / .2): the
+    transfer functions of one BEM body; the sea state is the scene's [waves]."""
+    from ..decks.bem_waves import read_excitation
+    problems.known_keys(table, where, keys.effect_keys("wave_excitation", False))
+    data, path, body = _bem_entry(problems, table, where, read_excitation)
+    if data is None:
+        return None
+    x = data.body(body)
+    return {"bem": str(path), "body": body, "kind": data.kind, "omega": data.omega.tolist(),
+            "directions": data.directions.tolist(), "re": x.real.tolist(), "im": x.imag.tolist(),
+            "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g,
+            "water_depth": data.water_depth}
+
+
+def _bem_hydrostatics(problems, table, where):
+    """Hydrostatic restoring −C·(η − η0) from a BEM result (Capytaine .nc, WAMIT .hst)."""
+    from ..decks.bem_waves import read_hydrostatics
+    problems.known_keys(table, where, keys.effect_keys("bem_hydrostatics", False))
+    data, path, body = _bem_entry(problems, table, where, read_hydrostatics)
+    if data is None:
+        return None
+    return {"bem": str(path), "body": body, "kind": data.kind, "stiffness": data.stiffness[body].tolist(),
+            "weight": data.weight, "mass": data.mass.get(body), "center_of_mass": data.center_of_mass.get(body),
+            "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g}
+
+
+# type -> (validator, default effect name)
+EFFECT_TYPES = {
+    "wave_excitation": (_wave_excitation, "waves"),
+    "bem_hydrostatics": (_bem_hydrostatics, "hydrostatics"),
+    "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
+    "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),
+    "riflex_body": (_riflex_body, "riflex_body"),
+}
