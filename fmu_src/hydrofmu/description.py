@@ -157,6 +157,35 @@ class Waves:
 
 
 @dataclass
+class Drift:
+    """A body's second-order wave drift (physics.drift) on the scene's wave field (the same
+    components as its ``Waves``): effect ``name`` (output ``<name>.force``), ``method``
+    mean | newman | qtf, ``cutoff`` [rad/s] (qtf: the largest |ω_i − ω_j| kept; inf: all),
+    ``omega`` [rad/s]; mean drift data: ``directions`` [deg] and ``values`` (nω, nβ, 6)
+    [N/m², N·m/m²]; QTF data: ``pairs`` (nP, 2) [deg] and ``re`` + i·``im`` (nω, nω, nP, 6),
+    referred to the global origin; ``position`` (x, y) [m] the body's mean position."""
+    name: str
+    method: str
+    cutoff: float
+    omega: np.ndarray
+    position: np.ndarray
+    directions: np.ndarray | None = None
+    values: np.ndarray | None = None
+    pairs: np.ndarray | None = None
+    re: np.ndarray | None = None
+    im: np.ndarray | None = None
+
+    def kernel(self, comps, g, depth):
+        """physics.drift.DriftLoad of the components ``comps``."""
+        from .physics.drift import QTF, DriftLoad, MeanDrift
+        if self.pairs is not None:
+            data = QTF(self.omega, [tuple(p) for p in self.pairs], self.re + 1j * self.im, self.position, g, depth)
+        else:
+            data = MeanDrift(self.omega, self.directions, self.values)
+        return DriftLoad(self.method, comps, data, self.cutoff, self.position, g, depth)
+
+
+@dataclass
 class LoadFMU:
     """Hydrodynamic loads on one body: its effects and coupling sides.  ``position``,
     ``attitude``, ``velocity``: the reference point's state at t = 0 (the motion inputs'
@@ -172,6 +201,7 @@ class LoadFMU:
     environment: Environment
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
     waves: Waves | None = None
+    drift: Drift | None = None
 
 
 @dataclass

@@ -94,6 +94,10 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     """The model records of a built Python slave (fmi/fmu.h, fmi/models.c read them)."""
     recs = [("kind", [KINDS[type(desc)]]), ("start", slave.values.tolist())]
     if isinstance(desc, description.LoadFMU):
+        if getattr(desc, "drift", None) is not None:
+            raise InputError(desc.description, None, f"effect {desc.drift.name}",
+                             "wave_drift has no compiled kernel yet: build this scene with "
+                             "runtime = \"python\" ([build] runtime, or --runtime python)")
         if getattr(desc, "waves", None) is not None:
             recs += _waves(slave)
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),

@@ -70,6 +70,7 @@ from ..physics.memory import StateSpace
 from ..physics.rigid_body import CoupledBodies, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
+from ..physics.drift import phasors as drift_phasors
 from ..physics.waves import WaveLoad, components as wave_components
 
 # the sea-state knobs each spectrum exposes as waves.* parameters: (unit, description)
@@ -522,7 +523,7 @@ class LoadSlave(ArraySlave):
                              for e in self.loads.effects]
         self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
-        wave_force = self._add_waves(cfg.waves)
+        wave_force = self._add_waves(cfg.waves) + self._add_drift(getattr(cfg, "drift", None))
         # every load output in one block: total, each effect, each coupling, the waves
         self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
                                      + wave_force)]
@@ -557,6 +558,17 @@ class LoadSlave(ArraySlave):
         self.depends([force, slice(self.elevation, self.elevation + 1)], [])
         return [force]
 
+    def _add_drift(self, cfg):
+        """The output <name>.force of the body's wave drift (on the waves' sea state); returns
+        [the force slice] or []."""
+        self.drift, self.drift_cfg = None, cfg
+        if cfg is None:
+            return []
+        force = self.add_vector(f"{cfg.name}.force", 6, Fmi2Causality.output, LIN_ROT["force"], None,
+                                f"second-order wave drift ({cfg.method}), global axes, about the reference point")
+        self.depends([force], [])
+        return [force]
+
     def _start_waves(self):
         """The wave kernel of the sea state the waves.* parameters hold now (one error naming
         the knob when they are not a usable sea state)."""
@@ -571,6 +583,9 @@ class LoadSlave(ArraySlave):
             sea.check()
             comps = wave_components(sea, tuple(cfg.window))
             self.wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
+            if self.drift_cfg is not None:   # the same components: one sea
+                self.drift = self.drift_cfg.kernel(comps, g, sea.depth)
+                self.sea_components, self.ramp_length = comps, sea.ramp
         except ValueError as exc:
             raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 
@@ -610,17 +625,21 @@ class LoadSlave(ArraySlave):
                 return
         v = self.values
         ne = len(self.loads.effects)
-        out = np.zeros((1 + ne + len(self.couplings) + (self.wave_cfg is not None), 6))   # total, effects, couplings, waves
+        nw = (self.wave_cfg is not None) + (self.drift_cfg is not None)
+        out = np.zeros((1 + ne + len(self.couplings) + nw, 6))   # total, effects, couplings, waves, drift
         if ne:
             self.loads.effect_loads(self.motion(self.motion_inputs), self.env(), out[1:1 + ne])
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
             out[k] -= mass.dot(v[acc])
-        if self.wave is not None:   # the last row: a function of time only
-            w = self.wave(self.next_time or 0.0)
-            out[-1] = w[:6]
+        if self.wave is not None:   # the last rows: functions of time only
+            t = self.next_time or 0.0
+            w = self.wave(t)
+            out[1 + ne + len(self.couplings)] = w[:6]
             v[self.elevation] = w[6]
+            if self.drift is not None:
+                out[-1] = self.drift(drift_phasors(self.sea_components, t, self.ramp_length))
         out[0] = self._load_total.dot(out)   # (ndarray.dot: half the call cost of @ here)
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the

@@ -52,6 +52,9 @@ import numpy as np
 from .waves import DIRECTION_TOL, Components, TransferFunction, WaveError, ramp, wave_number
 
 METHODS = ("mean", "newman", "qtf")
+SPREAD_REFUSED = ("the full QTF in a spread sea needs bidirectional data (every heading pair (β1, β2) of the "
+                  "file's headings); this QTF holds unidirectional pairs only: use method = \"newman\" or "
+                  "\"mean\", or a long-crested sea")
 
 
 def phasors(comps: Components, t: float, ramp_length: float = 0.0) -> np.ndarray:
@@ -127,7 +130,7 @@ class QTF:
             grid[:, :, index[round(a, 6)], index[round(b, 6)]] = values[:, :, p]
         self.grid = grid
         self.uni = np.array([not np.isnan(grid[0, 0, m, m, 0].real) for m in range(nh)])
-        self.bidirectional = not np.isnan(grid[0, 0, :, :, 0].real).any()
+        self.bidirectional = nh > 1 and not np.isnan(grid[0, 0, :, :, 0].real).any()
         self.position = np.asarray(position, dtype=float)[:2]
         self.g, self.depth = g, depth
         k = wave_number(self.omega, g, depth)
@@ -150,18 +153,16 @@ class QTF:
     def _heading_corners(self, bi, bj):
         """[(index β1, index β2, weight)] arrays of the heading corners for each pair."""
         bi, bj = np.atleast_1d(bi), np.atleast_1d(bj)
-        same = np.abs((bi - bj + 180.0) % 360.0 - 180.0) <= DIRECTION_TOL
-        if same.all():
+        if not self.bidirectional:
+            same = np.abs((bi - bj + 180.0) % 360.0 - 180.0) <= DIRECTION_TOL
+            if not same.all():
+                raise WaveError("spreading", SPREAD_REFUSED)
             m = np.flatnonzero(self.uni)
             if m.size == 0:
                 raise WaveError("direction", "the QTF has no unidirectional heading pair (β, β)")
             sub = _headings(self._dir.directions[m])
             j0, j1, f = sub._direction_weights(bi)
             return [(m[j0], m[j0], 1 - f), (m[j1], m[j1], f)]
-        if not self.bidirectional:
-            raise WaveError("spreading", "the full QTF in a spread sea needs bidirectional data (every heading pair "
-                                         "(β1, β2) of the file's headings); this QTF holds unidirectional pairs only: "
-                                         "use method = \"newman\" or \"mean\", or a long-crested sea")
         a0, a1, fa = self._dir._direction_weights(bi)
         b0, b1, fb = self._dir._direction_weights(bj)
         return [(a0, b0, (1 - fa) * (1 - fb)), (a0, b1, (1 - fa) * fb), (a1, b0, fa * (1 - fb)), (a1, b1, fa * fb)]
@@ -226,6 +227,8 @@ class DriftLoad:
 
     def _band(self, qtf, w, beta, cutoff):
         n = w.size
+        if not qtf.bidirectional and np.any(np.abs((beta - beta[0] + 180.0) % 360.0 - 180.0) > DIRECTION_TOL):
+            raise WaveError("spreading", SPREAD_REFUSED)
         if n > 1 and math.isfinite(cutoff):
             # the largest offset d with ω[k + d] − ω[k] ≤ cutoff for some k (ω sorted)
             d = max(int(np.max(np.searchsorted(w, w + cutoff * (1 + 1e-12), side="right") - 1 - np.arange(n))), 0)
