@@ -425,3 +425,27 @@ def test_meandrift_regenerates_the_cylinder_drift(tmp_path):
                                               resolution=(2, 16, 12)), wide)
     assert main(["meandrift", str(user), "--mesh", str(wide), "-o", str(tmp_path / "no.nc"), "--fixed"]) == 2
     assert not (tmp_path / "no.nc").exists()
+
+
+def test_bidirectional_qtf_in_a_spread_sea_is_bilinear_in_the_heading_pair():
+    """A QTF with the heading pairs (0, 0), (0, 30), (30, 0), (30, 30) (the mixed ones each
+    other's conjugate transpose): components at 10° and 25° feel Q interpolated bilinearly in
+    (β_i, β_j), computed by hand; the sum is real-symmetric (Hermitian data)."""
+    w = np.linspace(0.4, 1.4, 6)
+    rng = np.random.default_rng(5)
+    a00, a33 = hermitian_qtf(2 * np.pi / w, 1), hermitian_qtf(2 * np.pi / w, 2)
+    a03 = rng.normal(size=(6, 6, 6)) + 1j * rng.normal(size=(6, 6, 6))
+    a30 = np.conj(np.transpose(a03, (1, 0, 2)))
+    data = QTF(w, [(0.0, 0.0), (0.0, 30.0), (30.0, 0.0), (30.0, 30.0)], np.stack((a00, a03, a30, a33), axis=2))
+    assert data.bidirectional
+    comps = Components(w[[1, 3]], np.array([0.9, 1.2]), np.array([10.0, 25.0]), np.array([0.2, 1.7]))
+    z = phasors(comps, 7.1)
+    corners = {(0, 0): a00, (0, 1): a03, (1, 0): a30, (1, 1): a33}
+    want = np.zeros(6)
+    for i, (wi, bi) in enumerate(((1, 10.0), (3, 25.0))):
+        for j, (wj, bj) in enumerate(((1, 10.0), (3, 25.0))):
+            fa, fb = bi / 30.0, bj / 30.0
+            q = sum(corners[(a, b)][wi, wj] * (fa if a else 1 - fa) * (fb if b else 1 - fb)
+                    for a in (0, 1) for b in (0, 1))
+            want += (q * z[i] * np.conj(z[j])).real
+    assert np.allclose(DriftLoad("qtf", comps, data)(z), want, rtol=1e-12, atol=1e-12)

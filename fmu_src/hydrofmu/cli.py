@@ -421,7 +421,7 @@ def make_parser():
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "bem",
-                            "robust", "batch", "ecco", "longrun", "waves"),
+                            "robust", "batch", "ecco", "longrun", "waves", "drift"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="a smoke run of the cheaper parts at small sizes (about a minute of CPU; the "
                         "parts it leaves out are named), not the documented figures")
