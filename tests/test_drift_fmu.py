@@ -127,27 +127,107 @@ def test_held_body_full_qtf_uses_the_sea_of_its_waves(folder):
         np.testing.assert_allclose(row, want, rtol=1e-6, atol=1e-6 * np.abs(want).max())
 
 
-@pytest.mark.parametrize("case", ["qtf with spreading", "qtf from a .8", "cutoff without qtf", "compiled",
-                                  "no excitation"])
+@pytest.mark.parametrize("case", ["qtf with spreading", "qtf from a .8", "cutoff without qtf", "no excitation"])
 def test_bad_drift_set_ups_are_one_error(folder, case):
     sea = 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 40'
     drift, key = {
         "qtf with spreading": (f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "qtf"', "waves.spreading"),
         "qtf from a .8": (f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "qtf"', "bodies.cyl.effects[1].bem"),
         "cutoff without qtf": (f'bem = "cyl.8"\nulen = {ULEN}\ncutoff = 0.3', "bodies.cyl.effects[1].cutoff"),
-        "compiled": (f'bem = "cyl.8"\nulen = {ULEN}', "effect drift"),
         "no excitation": (f'bem = "cyl.8"\nulen = {ULEN}', "bodies.cyl.effects[0].type"),
     }[case]
     if case == "qtf with spreading":
         sea += "\ndirection = 45.0\nspreading = 60.0"   # within the excitation's 0…90°
-    path = scene(folder, sea, drift, runtime="c" if case == "compiled" else None)
+    path = scene(folder, sea, drift)
     if case == "no excitation":
         path.write_text(path.read_text().replace('type = "wave_excitation"\nbem = "wave_cylinder.nc"\n\n'
                                                  '[[bodies.cyl.effects]]\n', ''))
     with pytest.raises(InputError) as err:
-        if case == "compiled":
-            from hydrofmu import api
-            api.build(path, folder / "out")
-        else:
-            load_scene(path)
+        load_scene(path)
     assert key in str(err.value), str(err.value)
+
+
+# -------------------------------------------------------------- compiled flavour (drift.c)
+
+PAIR = DATA / "wave_pair.nc"
+
+
+def write_bidirectional_12d(path, periods, headings, seed=4):
+    """A bidirectional .12d: every heading pair, one triangle of the periods, Q(ω_j, ω_i; β2, β1)
+    the conjugate of Q(ω_i, ω_j; β1, β2) (so the file is a Hermitian QTF)."""
+    rng = np.random.default_rng(seed)
+    n, h = len(periods), len(headings)
+    q = rng.normal(size=(n, n, h, h, 6)) + 1j * rng.normal(size=(n, n, h, h, 6))
+    q = 0.5 * (q + np.conj(np.transpose(q, (1, 0, 3, 2, 4))))
+    lines = []
+    for a in range(n):
+        for b in range(a + 1):
+            for c in range(h):
+                for d in range(h):
+                    for i in range(6):
+                        v = q[a, b, c, d, i]
+                        if a == b and c == d:
+                            v = v.real
+                        lines.append(f"{periods[a]:14.6E}{periods[b]:14.6E}{headings[c]:14.6E}{headings[d]:14.6E}"
+                                     f"{i + 1:6d}{abs(v):14.6E}{math.degrees(np.angle(v)):14.6E}{v.real:14.6E}"
+                                     f"{v.imag:14.6E}\n")
+    path.write_text("".join(lines))
+
+
+def pair_scene(folder, waves, drift):
+    """cyl2 of the pair dataset (10 m from the origin: the drift's phases matter), held."""
+    shutil.copy(PAIR, Path(folder) / PAIR.name)
+    text = f"""[build]
+runtime = "c"
+
+[run]
+step = 0.1
+stop = 100.0
+
+[waves]
+{waves}
+
+[bodies.cyl2]
+position = [10.0, 0.0, 0.0]
+mass = 51190.0
+inertia = [2e5, 2e5, 1e5]
+
+[[bodies.cyl2.effects]]
+type = "wave_excitation"
+bem = "wave_pair.nc"
+body = "cyl2"
+
+[[bodies.cyl2.effects]]
+type = "wave_drift"
+{drift}
+"""
+    path = Path(folder) / "pair.toml"
+    path.write_text(text)
+    return path
+
+
+SPREAD = ('spectrum = "jonswap"\nhs = 3.0\ntp = 9.0\ndirection = 200.0\nspreading = 6.0\ncomponents = 60\nseed = 5\n'
+          'ramp = 15.0')
+COMPILED_CASES = {
+    "mean, regular": ('spectrum = "regular"\nheight = 2.0\nperiod = 7.0\ndirection = 30.0\nramp = 10.0',
+                      f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "mean"', {"waves.period": 8.5}),
+    "newman, spread": (SPREAD, f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "newman"', {"waves.seed": 11.0}),
+    "qtf, long-crested, cut-off": (SPREAD.replace("spreading = 6.0", "spreading = 0.0").replace("200.0", "0.0"),
+                                   f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "qtf"\ncutoff = 0.4', {"waves.hs": 2.0}),
+    "qtf, bidirectional, spread": (SPREAD, f'bem = "bi.12d"\nulen = {ULEN}\nmethod = "qtf"', {"waves.seed": 9.0}),
+}
+
+
+@pytest.mark.parametrize("case", list(COMPILED_CASES))
+def test_drift_compiled_equals_python(folder, case, tmp_path):
+    """physics/drift.c on the components waves.c draws = physics/drift.py on Python's, every
+    output of the load FMU to 1e-10 of its range over 300 steps, a body 10 m from the origin,
+    the sea state changed through waves.* at initialization."""
+    from hydrofmu.fmi.build import build_scene
+    from test_compiled import assert_equal_flavours
+    (folder / "cyl.8").write_text("".join(mean_rows(DRIFT_PERIODS, [0.0, 90.0, 180.0, 270.0], [1, 2, 6], f8)))
+    write_bidirectional_12d(folder / "bi.12d", DRIFT_PERIODS, [0.0, 90.0, 180.0, 270.0])
+    waves, drift, params = COMPILED_CASES[case]
+    built = build_scene(load_scene(pair_scene(folder, waves, drift)), folder / "fmus", log=lambda *_: None,
+                        runtime="c")
+    assert assert_equal_flavours(built, tmp_path, steps=300, params=params, loads_only=True) <= 1e-10

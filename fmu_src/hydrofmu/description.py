@@ -13,6 +13,7 @@ it at instantiation.
 from __future__ import annotations
 
 import json
+import math
 import types
 import typing
 from dataclasses import dataclass, field, fields, is_dataclass
@@ -175,14 +176,24 @@ class Drift:
     re: np.ndarray | None = None
     im: np.ndarray | None = None
 
+    def data(self, g, depth):
+        """physics.drift.QTF or MeanDrift of this body."""
+        from .physics.drift import QTF, MeanDrift
+        if self.pairs is not None:
+            return QTF(self.omega, [tuple(p) for p in self.pairs], self.re + 1j * self.im, self.position, g, depth)
+        return MeanDrift(self.omega, self.directions, self.values)
+
     def kernel(self, comps, g, depth):
         """physics.drift.DriftLoad of the components ``comps``."""
-        from .physics.drift import QTF, DriftLoad, MeanDrift
-        if self.pairs is not None:
-            data = QTF(self.omega, [tuple(p) for p in self.pairs], self.re + 1j * self.im, self.position, g, depth)
-        else:
-            data = MeanDrift(self.omega, self.directions, self.values)
-        return DriftLoad(self.method, comps, data, self.cutoff, self.position, g, depth)
+        from .physics.drift import DriftLoad
+        return DriftLoad(self.method, comps, self.data(g, depth), self.cutoff, self.position, g, depth)
+
+    def c_params(self):
+        """drift.c's record after the output: [method (0 mean, 1 newman, 2 qtf), cutoff (−1: none),
+        the data's c_params] (the wave numbers are drift.c's, from g and depth at initialization)."""
+        from .physics.drift import METHODS
+        return ([float(METHODS.index(self.method)), self.cutoff if math.isfinite(self.cutoff) else -1.0]
+                + self.data(9.81, math.inf).c_params())
 
 
 @dataclass

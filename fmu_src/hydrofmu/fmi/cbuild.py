@@ -30,7 +30,7 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # the FMU's C sources, relative to the package (and to the FMU's sources/ folder)
 SOURCES = ["fmi/fmu.c", "fmi/models.c", "physics/kinematics.c", "physics/current.c", "physics/viscous_drag.c",
            "physics/current_polar.c", "physics/lumped.c", "physics/joint.c", "physics/memory.c", "physics/waves.c",
-           "physics/hydrostatics.c", "physics/rigid.c"]
+           "physics/drift.c", "physics/hydrostatics.c", "physics/rigid.c"]
 HEADERS = ["fmi/fmu.h", "physics/kernels.h"]
 KINDS = {description.LoadFMU: 0, description.ConnectorFMU: 1, description.DynamicsFMU: 2}
 CAUSALITY = {"parameter": "p", "calculatedParameter": "c", "input": "i", "output": "o"}
@@ -94,12 +94,11 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     """The model records of a built Python slave (fmi/fmu.h, fmi/models.c read them)."""
     recs = [("kind", [KINDS[type(desc)]]), ("start", slave.values.tolist())]
     if isinstance(desc, description.LoadFMU):
-        if getattr(desc, "drift", None) is not None:
-            raise InputError(desc.description, None, f"effect {desc.drift.name}",
-                             "wave_drift has no compiled kernel yet: build this scene with "
-                             "runtime = \"python\" ([build] runtime, or --runtime python)")
         if getattr(desc, "waves", None) is not None:
             recs += _waves(slave)
+        if getattr(desc, "drift", None) is not None:   # drift.c, on the components waves.c draws
+            vr = {v.name: k for k, v in slave.vars.items()}
+            recs.append(("drift", [vr[f"{desc.drift.name}.force[1]"]] + desc.drift.c_params()))
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]
         for e, out in zip(slave.loads.effects, slave.effect_force):

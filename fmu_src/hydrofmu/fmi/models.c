@@ -180,6 +180,9 @@ typedef struct {
     const double *waves, *transfer;        /* the 'waves' and 'transfer' records (NULL: no waves) */
     double *wave;                          /* waves.c's per-step parameters (NULL: not drawn yet) */
     int wave_force, wave_elevation;
+    const double *driftrec;                /* the 'drift' record after its output (NULL: no drift) */
+    int ndriftrec, drift_force;
+    double *drift;                         /* drift.c's per-step parameters (with the waves') */
     Effect *effects;
     int neffects;
     Coupling *couplings;
@@ -191,7 +194,7 @@ static void load_release(Instance *inst) {
     if (!L) return;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) memory_free(&L->couplings[k].memory);
-    free(L->effects), free(L->couplings), free(L->wave), free(L);
+    free(L->effects), free(L->couplings), free(L->wave), free(L->drift), free(L);
     inst->data = NULL;
 }
 
@@ -220,6 +223,9 @@ static int load_setup(Instance *inst) {
         } else if (strcmp(e->tag, "waves") == 0) {
             if (e->n != 5 + 2 * SEA_KNOBS) goto bad;
             L->wave_force = ivr(e->v[0]), L->wave_elevation = ivr(e->v[1]), L->waves = e->v;
+        } else if (strcmp(e->tag, "drift") == 0) {
+            if (e->n < 2 || !hf_drift_record_ok(e->v + 1, e->n - 1)) goto bad;
+            L->drift_force = ivr(e->v[0]), L->driftrec = e->v + 1, L->ndriftrec = e->n - 1;
         } else if (strcmp(e->tag, "transfer") == 0) {
             int nw = e->n > 7 ? ivr(e->v[5]) : 0, nb = e->n > 7 ? ivr(e->v[6]) : 0;
             if (nw < 1 || nb < 1 || e->n != 7 + nw + nb + 12 * nw * nb) goto bad;
@@ -235,7 +241,7 @@ static int load_setup(Instance *inst) {
             if (memory_init(m)) goto bad;
         }
     }
-    if (!L->waves != !L->transfer) goto bad;
+    if (!L->waves != !L->transfer || (L->driftrec && !L->waves)) goto bad;
     return 0;
 bad:
     hf_fail(inst, "model.bin: the load model's records are incomplete or of the wrong size");
@@ -254,6 +260,15 @@ static int draw_waves(Instance *inst, Load *L) {
     free(L->wave);
     L->wave = hf_wave_build(&sea, L->transfer, v[ivr(w[2])], field, message, sizeof message);
     if (!L->wave) hf_fail(inst, "waves.%s: %s", field, message);
+    if (L->wave && L->driftrec) {   /* the drift on the same components (LoadSlave._start_waves) */
+        free(L->drift);
+        L->drift = hf_drift_build(L->wave, L->driftrec, L->ndriftrec, v[ivr(w[2])], w[4], field, message,
+                                  sizeof message);
+        if (!L->drift) {
+            hf_fail(inst, "waves.%s: %s", field, message);
+            free(L->wave), L->wave = NULL;
+        }
+    }
     return L->wave ? 0 : -1;
 }
 
@@ -324,6 +339,7 @@ static void load_evaluate(Instance *inst) {
         hf_waves(L->wave, inst->has_next ? inst->next_time : 0.0, w);
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
+        if (L->drift) hf_drift(L->drift, inst->has_next ? inst->next_time : 0.0, v + L->drift_force);
     }
     double *total = v + L->total;
     for (int i = 0; i < 6; i++) total[i] = 0.0;
@@ -332,6 +348,7 @@ static void load_evaluate(Instance *inst) {
     for (int k = 0; k < L->ncouplings; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->couplings[k].out + i];
     for (int i = 0; i < 6 && L->waves; i++) total[i] += v[L->wave_force + i];
+    for (int i = 0; i < 6 && L->drift; i++) total[i] += v[L->drift_force + i];
 }
 
 static void load_step(Instance *inst, double t, double dt) {

@@ -582,10 +582,11 @@ class LoadSlave(ArraySlave):
         try:
             sea.check()
             comps = wave_components(sea, tuple(cfg.window))
-            self.wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
-            if self.drift_cfg is not None:   # the same components: one sea
+            wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
+            if self.drift_cfg is not None:   # the same components: one sea (both or neither)
                 self.drift = self.drift_cfg.kernel(comps, g, sea.depth)
                 self.sea_components, self.ramp_length = comps, sea.ramp
+            self.wave = wave
         except ValueError as exc:
             raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 

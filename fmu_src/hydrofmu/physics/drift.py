@@ -104,6 +104,12 @@ class MeanDrift:
         """(n, 6) real for n components ω [rad/s], β [deg]."""
         return self.table.at(omega, beta).real
 
+    def c_params(self):
+        """drift.c's data: [nω, ω, nβ, closed, directions, values (nω, nβ, 6)]."""
+        t = self.table
+        return ([t.omega.size] + t.omega.tolist() + [t.directions.size, float(t.closed)] + t.directions.tolist()
+                + t.values.real.ravel().tolist())
+
 
 class QTF:
     """Difference-frequency QTF Q(ω_i, ω_j; β_i, β_j) [N/m², N·m/m²] of one body.
@@ -142,6 +148,18 @@ class QTF:
     @property
     def window(self):
         return float(self.omega[0]), float(self.omega[-1])
+
+    def c_params(self):
+        """drift.c's data: [nω, ω, nh, closed, bidirectional, nu, closed (unidirectional), the
+        unidirectional headings' indices (nu), headings (nh), x, y, Re Q, Im Q (nω, nω, nh, nh, 6)
+        referred to the origin, 0 where the file has no pair]."""
+        m = np.flatnonzero(self.uni)
+        sub = _headings(self._dir.directions[m]) if m.size else None
+        q = np.nan_to_num(self.grid)
+        return ([self.omega.size] + self.omega.tolist()
+                + [self._dir.directions.size, float(self._dir.closed), float(self.bidirectional), m.size,
+                   float(sub.closed) if sub is not None else 0.0] + m.tolist() + self._dir.directions.tolist()
+                + self.position.tolist() + q.real.ravel().tolist() + q.imag.ravel().tolist())
 
     def diagonal(self) -> MeanDrift:
         """The mean drift Q(ω, ω; β, β) of the unidirectional headings."""

@@ -73,12 +73,20 @@ typedef struct {
 /* 0, or -1 with the bad knob's name in field (16 chars) and why in message */
 int hf_sea_check(const HfSea *sea, char *field, char *message, size_t size);
 double hf_wave_number(double omega, double g, double depth);
-/* the per-step parameters [n, ramp length, omega (n), table (2n x 7)] (malloc'd; NULL: field and
+/* the per-step parameters [n, ramp length, omega (n), table (2n x 7), directions (n)] (malloc'd; NULL: field and
  * message say why) of a sea state and a transfer function [window_lo, window_hi, x, y, closed, nw,
  * nb, omega (nw), directions (nb), re (nw nb 6), im (nw nb 6)] (TransferFunction.c_params) */
 double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *field, char *message, size_t size);
 /* out: [F (6), elevation] at time t */
 void hf_waves(const double *params, double t, double *out);
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac);
+
+/* drift.c: the wave drift of a body on the components of hf_wave_build's parameters
+ * (physics.drift.DriftLoad); the record from MeanDrift/QTF.c_params */
+double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
+                       char *message, size_t size);
+void hf_drift(double *params, double t, double *out);   /* out (6); params' scratch is written */
+int hf_drift_record_ok(const double *record, int n);
 
 /* hydrostatics.c: params [C (36, row-major), position0 (3), yaw0, vertical0 (3)]: F = -C delta */
 void hf_hydrostatics(const double *params, const HfMotion *m, double *out);

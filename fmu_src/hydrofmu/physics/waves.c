@@ -176,12 +176,11 @@ static int transfer_init(Transfer *T, const double *p, double g, double depth) {
     return 0;
 }
 
-/* TransferFunction._direction_weights for one direction; -1: outside the computed ones */
-static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
-    const double *d = T->d;
-    int nb = T->nb;
+/* TransferFunction._direction_weights for one direction over the directions d (nb, sorted
+ * in [0, 360)), closed when they go round the circle; -1: outside the computed ones */
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac) {
     beta = wrap360(beta);
-    if (T->closed) {
+    if (closed) {
         if (beta < d[0]) beta += 360.0;   /* below the first: across the wrap from the last */
         int j = 0;   /* searchsorted(ext, beta, 'right') - 1, clipped to 0 ... nb - 1 */
         while (j < nb && (j + 1 < nb ? d[j + 1] : d[0] + 360.0) <= beta) j++;
@@ -204,6 +203,10 @@ static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, d
     double f = (beta - d[j]) / (d[j + 1] - d[j]);
     *j0 = j, *j1 = j + 1, *frac = f < 0 ? 0 : f > 1 ? 1 : f;
     return 0;
+}
+
+static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
+    return hf_direction_weights(T->d, T->nb, T->closed, beta, j0, j1, frac);
 }
 
 /* TransferFunction.at for one component: X (6 complex, (re, im) pairs) referred to the origin */
@@ -302,7 +305,8 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
     if (hf_sea_check(sea, field, m, size)) return NULL;
     const double lo_w = transfer[0], hi_w = transfer[1];
     int n = sea->spectrum == 0 ? 1 : (int)sea->components;
-    double *params = malloc(sizeof(double) * (2 + n + 14 * n)), *w = malloc(sizeof(double) * 4 * n);
+    /* [n, ramp, omega (n), table (14 n), directions (n): the components' own, for drift.c] */
+    double *params = malloc(sizeof(double) * (2 + n + 14 * n + n)), *w = malloc(sizeof(double) * 4 * n);
     double *amp = w + n, *beta = amp + n, *phase = beta + n;
     Spectrum *sp = NULL;
     Transfer T = {0};
@@ -364,6 +368,7 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
         }
         table[7 * k + 6] = cr * er - ci * ei;
         table[7 * (n + k) + 6] = -(cr * ei + ci * er);
+        table[14 * n + k] = beta[k];
     }
     free(T.local), free(sp), free(w);
     return params;
