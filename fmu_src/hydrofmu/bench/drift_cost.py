@@ -66,6 +66,63 @@ def cost(counts=COUNTS, calls=300, rounds=5):
     return rows
 
 
+def c_cost(counts=COUNTS, rounds=5, steps=2000):
+    """Rows per component count: µs per step of the compiled kernels (physics/waves.c's
+    hf_waves, physics/drift.c's hf_drift per method), timed in a C loop (bench/drift_timing.c),
+    median of interleaved rounds."""
+    import ctypes
+    from pathlib import Path
+    from ..cc import cached_many
+    from ..description import Drift
+    from ..physics.waves import TransferFunction
+    here = Path(__file__).resolve().parent
+    lib = ctypes.CDLL(str(cached_many([here.parent / "physics" / "waves.c", here.parent / "physics" / "drift.c",
+                                       here / "drift_timing.c"], "drift_bench", libs=["-lm"],
+                                      flags=["-O3", "-shared", "-fPIC", "-std=c99"])))
+    lib.hf_wave_build.restype = ctypes.POINTER(ctypes.c_double)
+    lib.hf_drift_build.restype = ctypes.POINTER(ctypes.c_double)
+    lib.hf_bench_per_call.restype = ctypes.c_double
+    lib.hf_bench_per_call.argtypes = [ctypes.POINTER(ctypes.c_double), ctypes.c_int, ctypes.c_int, ctypes.c_double]
+
+    class Sea(ctypes.Structure):
+        _fields_ = [("spectrum", ctypes.c_int)] + [(k, ctypes.c_double) for k in (
+            "height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp",
+            "depth")]
+    data = bench_qtf()
+    flat = TransferFunction(data.omega, [0.0], np.ones((data.omega.size, 1, 6), complex)).c_params(data.window)
+    pairs = np.array([[0.0, 0.0]])
+    q = data.grid[:, :, 0, 0][:, :, None, :]
+    rows = []
+    for n in counts:
+        sea = Sea(1, 0.0, 10.0, 0.0, 2.0, 9.0, 3.3, 0.0, 0.0, float(n), 1.0, 0.0, math.inf)
+        f, m = ctypes.create_string_buffer(16), ctypes.create_string_buffer(400)
+        wave = lib.hf_wave_build(ctypes.byref(sea), (ctypes.c_double * len(flat))(*flat), ctypes.c_double(9.81), f, m,
+                                 ctypes.c_size_t(400))
+        params = {"waves": wave}
+        for label, method, cut in (("mean", "mean", math.inf), ("newman", "newman", math.inf),
+                                   ("qtf_cut", "qtf", 0.3), ("qtf", "qtf", math.inf)):
+            rec = Drift("drift", method, cut, data.omega, np.zeros(2), pairs=pairs, re=q.real, im=q.imag).c_params()
+            if method != "qtf":
+                mean = data.diagonal()
+                rec = [float(("mean", "newman").index(method)), -1.0] + mean.c_params()
+            p = lib.hf_drift_build(wave, (ctypes.c_double * len(rec))(*rec), len(rec), ctypes.c_double(9.81),
+                                   ctypes.c_double(math.inf), f, m, ctypes.c_size_t(400))
+            assert p, m.value
+            params[label] = p
+        calls = max(50, steps // (1 + n // 100))
+        times = {k: [] for k in params}
+        for _ in range(rounds):
+            for k, p in params.items():
+                times[k].append(lib.hf_bench_per_call(p, 0 if k == "waves" else 1, calls, 0.05))
+        per = {k: float(np.median(v)) for k, v in times.items()}
+        row = {"components": n, **{f"c_{k}_us": 1e6 * v for k, v in per.items()}}
+        row.update({f"c_{k}_x_waves": per[k] / per["waves"] for k in per if k != "waves"})
+        rows.append(row)
+        for p in params.values():
+            ctypes.CDLL(None).free(p)
+    return rows
+
+
 def newman_error(n=200, hours=2.0, dt=2.0):
     """Newman against the full QTF in one record: {force_std_ratio, force_rms_error (of the
     QTF's std), surge_std_ratio, mean_ratio} (Newman / QTF)."""
@@ -91,11 +148,16 @@ def newman_error(n=200, hours=2.0, dt=2.0):
             "surge_std_ratio": xn.std() / xq.std()}
 
 
-def lines(rows, err):
+def lines(rows, err, crows=None):
     out = ["cost per step in-process (phasors included), × the first-order waves kernel: " + "; ".join(
         f"{r['components']} components: waves {r['waves_us']:.0f} µs, mean {r['mean_x_waves']:.2f}×, newman "
         f"{r['newman_x_waves']:.2f}×, qtf cut 0.3 rad/s ({r['qtf_cut_offsets']} offsets) {r['qtf_cut_x_waves']:.1f}×, "
         f"qtf all pairs {r['qtf_x_waves']:.1f}×" for r in rows)]
+    if crows:
+        out.append("compiled kernels (physics/drift.c against waves.c's hf_waves, a C loop): " + "; ".join(
+            f"{r['components']} components: waves {r['c_waves_us']:.2f} µs, mean {r['c_mean_x_waves']:.2f}×, newman "
+            f"{r['c_newman_x_waves']:.2f}×, qtf cut 0.3 rad/s {r['c_qtf_cut_x_waves']:.1f}×, qtf all pairs "
+            f"{r['c_qtf_x_waves']:.1f}×" for r in crows))
     out.append(f"Newman against the full QTF (test QTF, {err['components']} components, {err['record_h']:g} h): mean "
                f"{err['mean_ratio']:.3f}, slow-drift force std {err['force_std_ratio']:.3f}, rms difference "
                f"{100 * err['force_rms_error']:.0f} % of the QTF force's std, moored surge std (100 s, 10 % damping) "

@@ -564,11 +564,13 @@ def waves_lines(rows):
 
 def part_drift(out, quick):
     from . import drift_cost
-    rows = drift_cost.cost((50, 200) if quick else drift_cost.COUNTS, rounds=2 if quick else 5)
+    counts = (50, 200) if quick else drift_cost.COUNTS
+    rows = drift_cost.cost(counts, rounds=2 if quick else 5)
+    crows = drift_cost.c_cost(counts, rounds=2 if quick else 5)
     err = drift_cost.newman_error(hours=0.5 if quick else 2.0)
-    write_csv(out / "drift.csv", rows)
+    write_csv(out / "drift.csv", [{**r, **c} for r, c in zip(rows, crows)])
     write_csv(out / "drift_newman.csv", [err])
-    return drift_cost.lines(rows, err)
+    return drift_cost.lines(rows, err, crows)
 
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,

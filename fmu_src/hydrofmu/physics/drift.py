@@ -234,14 +234,18 @@ class DriftLoad:
             return
         mean = data.diagonal() if isinstance(data, QTF) else data
         q = mean.at(w, beta)                                  # (N, 6) real
+        # the tables act on z's floats [Re z_0, Im z_0, Re z_1, …] (one real product a step)
         if method == "mean":
-            self.coef = q
+            self.table = np.repeat(q, 2, axis=0)              # |z_k|² = Re² + Im²
             return
         k = wave_number(w, g, depth)
         b = np.radians(beta)
         shift = np.exp(-1j * k * (position[0] * np.cos(b) + position[1] * np.sin(b)))[:, None]
-        self.plus = np.sqrt(np.maximum(q, 0.0)) * shift
-        self.minus = np.sqrt(np.maximum(-q, 0.0)) * shift
+        table = np.empty((2 * w.size, 24))
+        for col, s in ((0, np.sqrt(np.maximum(q, 0.0)) * shift), (12, np.sqrt(np.maximum(-q, 0.0)) * shift)):
+            table[0::2, col:col + 6], table[1::2, col:col + 6] = s.real, -s.imag      # Re(z·s)
+            table[0::2, col + 6:col + 12], table[1::2, col + 6:col + 12] = s.imag, s.real   # Im(z·s)
+        self.table = table
 
     def _band(self, qtf, w, beta, cutoff):
         n = w.size
@@ -268,13 +272,17 @@ class DriftLoad:
 
     def __call__(self, z) -> np.ndarray:
         """(6,) [Fx, Fy, Fz, Mx, My, Mz] for the components' complex amplitudes z (N,)."""
-        z = np.asarray(z)[self.order]
+        z = np.ascontiguousarray(np.asarray(z, dtype=complex)[self.order])
         if self.method == "mean":
-            return (z.real ** 2 + z.imag ** 2) @ self.coef
+            v = z.view(np.float64)
+            return (v * v) @ self.table
         if self.method == "newman":
-            p, m = z @ self.plus, z @ self.minus
-            return p.real ** 2 + p.imag ** 2 - m.real ** 2 - m.imag ** 2
+            p = z.view(np.float64) @ self.table               # Re, Im of Σ z·√Q⁺ and of Σ z·√Q⁻
+            p *= p
+            return p[:6] + p[6:12] - p[12:18] - p[18:]
         n, d = self.n, self.offsets
         self._pad[:n] = np.conj(z)
         pairs = z[:, None] * np.lib.stride_tricks.sliding_window_view(self._pad, d + 1)   # [i, off] z_i·conj(z_{i+off})
-        return np.ascontiguousarray(pairs).ravel().view(np.float64) @ self.table
+        # (einsum: one pass over the table; a BLAS gemv of this tall shape was 10× slower on a
+        # busy 2-core machine, its threads fighting for the cores)
+        return np.einsum("i,ij->j", np.ascontiguousarray(pairs).ravel().view(np.float64), self.table)
