@@ -453,6 +453,10 @@ def make_parser():
     d.add_argument("--fixed", action="store_true", help="a held body: no motions (diffraction only)")
     d.add_argument("--ntheta", type=int, default=361, help="Kochin directions over the circle")
     d.add_argument("--no-lid", action="store_true", help="no interior lid (irregular frequencies not removed)")
+    d.add_argument("--omega", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="only the dataset's frequencies in [LO, HI] rad/s (default: all)")
+    d.add_argument("--every", type=int, default=1, help="every N-th of those frequencies")
+    d.add_argument("--directions", nargs="+", type=float, help="only these headings [deg] of the dataset")
     return parser
 
 
@@ -552,7 +556,8 @@ def _main(argv):
             raise InputError("command line", None, "--ntheta", f"at least 16 directions, found {args.ntheta}")
         check_outputs(files=(args.out,), inputs=(args.dataset, args.mesh))
         keep(lambda p: add_mean_drift(args.dataset, args.mesh, p, fixed=args.fixed, ntheta=args.ntheta,
-                                      lid=not args.no_lid), args.out, _stderr)
+                                      lid=not args.no_lid, omega_range=args.omega, every=args.every,
+                                      directions=args.directions), args.out, _stderr)
     elif args.command == "bench":
         from .bench.run import main as bench
         check_folder(args.out)

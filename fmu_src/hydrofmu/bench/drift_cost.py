@@ -58,12 +58,19 @@ def cost(counts=COUNTS, calls=300, rounds=5):
             if label == "waves":
                 return lambda: (lambda k: load(dt * k))
             return lambda: (lambda k: load(phasors(comps, dt * k)))
-        per = timing.per_call({label: make(label) for label in loads}, max(20, calls // (1 + n // 200)), rounds)
+        got = timing.per_round({label: make(label) for label in loads}, max(20, calls // (1 + n // 200)), rounds)
+        per = {k: float(np.median(v)) for k, v in got.items()}
         row = {"components": n, **{f"{k}_us": 1e6 * v for k, v in per.items()},
-               "qtf_cut_offsets": loads["qtf_cut"].offsets}
+               "qtf_cut_offsets": loads["qtf_cut"].offsets, "noisy": noisy(got)}
         row.update({f"{k}_x_waves": per[k] / per["waves"] for k in loads if k != "waves"})
         rows.append(row)
     return rows
+
+
+def noisy(times, limit=0.25):
+    """True when a candidate's rounds spread by more than ``limit`` of their median (a busy
+    machine: the ratios are then not to be trusted)."""
+    return any((max(v) - min(v)) > limit * float(np.median(v)) for v in times.values())
 
 
 def c_cost(counts=COUNTS, rounds=5, steps=2000):
@@ -115,7 +122,7 @@ def c_cost(counts=COUNTS, rounds=5, steps=2000):
             for k, p in params.items():
                 times[k].append(lib.hf_bench_per_call(p, 0 if k == "waves" else 1, calls, 0.05))
         per = {k: float(np.median(v)) for k, v in times.items()}
-        row = {"components": n, **{f"c_{k}_us": 1e6 * v for k, v in per.items()}}
+        row = {"components": n, **{f"c_{k}_us": 1e6 * v for k, v in per.items()}, "c_noisy": noisy(times)}
         row.update({f"c_{k}_x_waves": per[k] / per["waves"] for k in per if k != "waves"})
         rows.append(row)
         for p in params.values():
@@ -149,15 +156,16 @@ def newman_error(n=200, hours=2.0, dt=2.0):
 
 
 def lines(rows, err, crows=None):
+    """The part's summary lines; '(noisy)': the rounds of that count spread by more than 25 %."""
     out = ["cost per step in-process (phasors included), × the first-order waves kernel: " + "; ".join(
         f"{r['components']} components: waves {r['waves_us']:.0f} µs, mean {r['mean_x_waves']:.2f}×, newman "
         f"{r['newman_x_waves']:.2f}×, qtf cut 0.3 rad/s ({r['qtf_cut_offsets']} offsets) {r['qtf_cut_x_waves']:.1f}×, "
-        f"qtf all pairs {r['qtf_x_waves']:.1f}×" for r in rows)]
+        f"qtf all pairs {r['qtf_x_waves']:.1f}×" + (" (noisy)" if r["noisy"] else "") for r in rows)]
     if crows:
         out.append("compiled kernels (physics/drift.c against waves.c's hf_waves, a C loop): " + "; ".join(
             f"{r['components']} components: waves {r['c_waves_us']:.2f} µs, mean {r['c_mean_x_waves']:.2f}×, newman "
             f"{r['c_newman_x_waves']:.2f}×, qtf cut 0.3 rad/s {r['c_qtf_cut_x_waves']:.1f}×, qtf all pairs "
-            f"{r['c_qtf_x_waves']:.1f}×" for r in crows))
+            f"{r['c_qtf_x_waves']:.1f}×" + (" (noisy)" if r["c_noisy"] else "") for r in crows))
     out.append(f"Newman against the full QTF (test QTF, {err['components']} components, {err['record_h']:g} h): mean "
                f"{err['mean_ratio']:.3f}, slow-drift force std {err['force_std_ratio']:.3f}, rms difference "
                f"{100 * err['force_rms_error']:.0f} % of the QTF force's std, moored surge std (100 s, 10 % damping) "

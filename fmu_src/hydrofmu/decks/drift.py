@@ -407,26 +407,38 @@ def _capytaine_mean(path):
                                                          "gives directions in radians")
     idx = np.arange(rad.size)
     values, warnings = [], []
+    # frequencies where the drift was not computed (hydrofmu meandrift --omega/--every): NaN rows
+    solved = np.ones(int(keep.sum()), bool)
+    for name in names:
+        var = ds[name]
+        dims = [d for d in var.dims if d != "complex"]
+        if sorted(dims) == sorted(want):
+            q = np.moveaxis(_complex(var, path), [dims.index(d) for d in want], [0, 1, 2])[keep][order]
+            solved &= ~np.all(np.isnan(q.real), axis=(1, 2))
+    if not solved.all():
+        warnings.append(f"{path}: the drift is not computed at {int((~solved).sum())} of the dataset's "
+                        f"{solved.size} frequencies (NaN rows): read at the {int(solved.sum())} others")
     for name in names:
         var = ds[name]
         dims = [d for d in var.dims if d != "complex"]
         if sorted(dims) != sorted(want):
             raise InputError(path, None, name, f"expected dimensions {want}, found {tuple(dims)}")
-        q = np.moveaxis(_complex(var, path), [dims.index(d) for d in want], [0, 1, 2])[keep][order]
+        q = np.moveaxis(_complex(var, path), [dims.index(d) for d in want], [0, 1, 2])[keep][order][solved]
         diag = q[:, idx, idx]
         bad = ~np.isfinite(diag)
         if bad.any():
             i, j = np.argwhere(bad)[0]
             raise InputError(path, None, name, f"{bad.sum()} non-finite value(s) on the diagonal, first at omega="
-                                               f"{omega[keep][order][i]:g} rad/s, wave_direction={np.degrees(rad[j]):g}°")
+                                               f"{omega[keep][order][solved][i]:g} rad/s, wave_direction="
+                                               f"{np.degrees(rad[j]):g}°")
         if np.any(np.abs(diag.imag) > REAL_RTOL * np.abs(diag) + 1e-9 * max(np.abs(diag).max(), 1.0)):
             raise InputError(path, None, name, "the diagonal (wave_direction_k = wave_direction_l) is the mean drift, "
                                                "real; found imaginary parts")
         values.append(diag.real)
-        if rad.size > 1:
+        if rad.size > 1 and not any("bidirectional" in w for w in warnings):
             warnings.append(f"{path}: {name}: the bidirectional entries (wave_direction_k ≠ wave_direction_l) are not "
                             f"read (the mean drift of a sea uses the diagonal)")
-    omega = omega[keep][order]
+    omega = omega[keep][order][solved]
     if omega.size < 1:
         raise InputError(path, None, "omega", "no finite frequency: no mean drift")
     dofs = [("body" if "body" not in ds.coords else str(np.atleast_1d(ds["body"].values)[0]), CAPYTAINE_DRIFT[n])
@@ -435,4 +447,4 @@ def _capytaine_mean(path):
     return MeanDriftData(str(path), "Capytaine", omega, np.degrees(rad), np.stack(values, axis=-1), dofs, bodies,
                          rotation_centers=_centres(ds, bodies), rho=_scalar(ds, "rho", path),
                          g=_scalar(ds, "g", path), water_depth=_scalar(ds, "water_depth", path),
-                         warnings=warnings[:1])
+                         warnings=warnings)
