@@ -14,7 +14,8 @@ each reader gets systematic edits, and each edit must end in one of
 
 anything else (loads differ without an error, another exception, an error naming no line of
 the file) fails.  Edits: drop a line, duplicate a line, append a word (``0.1`` and ``WORD``)
-to each keyword line, shorten each keyword word to one capital fewer, insert an unknown group
+to each keyword line, append a number to each row of numbers (a row with more fields than its
+format: issue 31's corpus class), shorten each keyword word to one capital fewer, insert an unknown group
 at every line inside each group read, swap each pair of adjacent lines.  Data lines only
 (comments and blank lines are not edited).  Counts per reader: ``run_all()``."""
 import re
@@ -270,6 +271,9 @@ def edits(reader, text, reading):
     for i in index:
         out.append(("drop a line", i, join(lines[:i] + lines[i + 1:]) + "\n"))
         out.append(("duplicate a line", i, join(lines[:i + 1] + lines[i:]) + "\n"))
+        code = _code(lines[i], reader.comments).rstrip()
+        if _number_line(code) and not code.endswith("&"):
+            out.append(("append a number", i, join(lines[:i] + [code + " 0.1"] + lines[i + 1:]) + "\n"))
     for a, b in zip(index, index[1:]):
         out.append(("swap two lines", a, join(lines[:a] + [lines[b]] + lines[a + 1:b] + [lines[a]] + lines[b + 1:])
                      + "\n"))

@@ -72,7 +72,7 @@ def test_batch_equals_single_runs(client, tmp_path):
                            record=OUTPUTS, log=lambda *_: None)
         for j, name in enumerate(OUTPUTS):
             x = ref.values[:, j]
-            want = {"max": x.max(), "min": x.min(), "mean": x.mean(), "std": x.std(), "final": x[-1]}
+            want = {"max": x.max(), "min": x.min(), "mean": x.mean(), "std": x.std(), "final": x[-1], "initial": x[0]}
             for stat, value in want.items():
                 assert row[f"{name}.{stat}"] == pytest.approx(value, rel=1e-12, abs=1e-12 * np.abs(x).max()), \
                     (row["case"], name, stat)
@@ -217,11 +217,35 @@ def test_sea_state_knobs_share_one_build(client, tmp_path):
     assert len(table) == 4 and (table["status"] == "ok").all(), table[["status", "error"]]
     assert table["build"].nunique() == 1
     for _, row in table.iterrows():
-        params = {"cyl.waves.hs": row["waves.hs"], "cyl.waves.tp": row["waves.tp"], "cyl.waves.seed": row["waves.seed"]}
+        params = {"cyl.waves.hs": row["hs"], "cyl.waves.tp": row["tp"], "cyl.waves.seed": row["seed"]}   # as written
         ref = run(inprocess.system(load_scene(scene), params), progress=False, record=outputs)
         after = ref.time >= 10.0
         for name in outputs:
             x = ref[name][after]
             assert row[f"{name}.std"] == pytest.approx(x.std(), rel=1e-9)
             assert row[f"{name}.significant"] == pytest.approx(4 * x.std(), rel=1e-9)
-        assert row["cyl.waves.elevation.significant"] == pytest.approx(row["waves.hs"], rel=0.25)   # 50 s of record
+        assert row["cyl.waves.elevation.significant"] == pytest.approx(row["hs"], rel=0.25)   # 50 s of record
+
+
+def test_capsized_and_the_linear_range_in_the_table(client, tmp_path):
+    """The wave-test cylinder, BEM hydrostatics only: a constant hold at 0.1 s grows its pitch
+    (σ = ω²h/4, test_hold) until it capsizes (a failed case saying so); the linear hold keeps the
+    free oscillation's amplitude, the initial pitch rate / ω (grown by its e^{ω(ωh)³/6·t}): 1.1°
+    from 0.03 rad/s (in range), 18° from 0.5 rad/s (out of it; ω computed here from the dataset)."""
+    import math
+    from hydrofmu.bench.hold import cylinder_scene
+    from test_hold import pitch_frequency
+    scene = cylinder_scene(tmp_path, "linear", 0.1, 60.0, memory=False, velocity=0.03)
+    cases = tmp_path / "cases.toml"
+    cases.write_text(f'scene = "{scene.name}"\noutputs = ["cyl_dynamics.attitude[2]"]\n'
+                     '[[cases]]\n"run.load_hold" = "constant"\n"run.stop" = 100.0\n'
+                     '[[cases]]\n"run.load_hold" = "linear"\n'
+                     '[[cases]]\n"bodies.cyl.velocity" = [0.0, 0.0, 0.0, 0.0, 0.5, 0.0]\n')
+    table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
+    assert list(table["status"]) == ["failed", "ok", "ok"], table[["status", "error"]]
+    assert table["error"].iloc[0].startswith("capsized: ") and "GimbalLock" not in table["error"].iloc[0]
+    assert list(table["linear_range"]) == [False, True, False]
+    w = pitch_frequency()
+    grown = math.exp(w * (w * 0.1) ** 3 / 6 * 60.0)   # the linear hold's slow growth over the 60 s (test_hold)
+    for k, rate in ((1, 0.03), (2, 0.5)):
+        assert table["max_tilt_deg"].iloc[k] == pytest.approx(math.degrees(rate / w) * grown, rel=0.03)

@@ -53,7 +53,8 @@ def test_kernel_element_rule_steady_velocity(method):
     timdel = 0.1
     h = 4.0e4 * np.exp(-2.0 * timdel * np.arange(50))             # decays to 2e-5 of h(0)
     c = Coupling.from_deck(CouplingData("c", ("", ""), "a", "b", np.zeros((6, 6)), timdel, {(3, 6): h}),
-                 method=method, tol=1e-6, v0_a=np.eye(6)[2] * 1.5, v0_b=np.eye(6)[5] * -0.4)
+                 method=method, tol=1e-4, v0_a=np.eye(6)[2] * 1.5, v0_b=np.eye(6)[5] * -0.4)
+    assert c.method == method   # (a tolerance below the fit's floor, 5.5e-5, falls back to convolution)
     for _ in range(24):                                         # constant velocities, 12 s ≫ kernel
         f_b = c.memory["B"].advance(0.5, np.eye(6)[2] * 1.5)  # A's heave drives B's yaw
         f_a = c.memory["A"].advance(0.5, np.eye(6)[5] * -0.4)  # B's yaw drives A's heave
@@ -79,7 +80,8 @@ def test_design_formula_full_matrices(method):
     data = random_data(rng)
     v_a, v_b = rng.normal(size=6), rng.normal(size=6)
     a_a, a_b = rng.normal(size=6), rng.normal(size=6)
-    c = Coupling.from_deck(data, method=method, tol=1e-4, v0_a=v_a, v0_b=v_b)
+    c = Coupling.from_deck(data, method=method, tol=1e-3, v0_a=v_a, v0_b=v_b)
+    assert c.method == method   # (the fits reach 7.8e-4; below it: convolution)
     for _ in range(40):                                        # 8 s > kernel length (5.8 s)
         f_a = c.memory["A"].advance(0.2, v_b)
         f_b = c.memory["B"].advance(0.2, v_a)
@@ -126,14 +128,15 @@ def test_self_coupling(method):
     t = 0.2 * np.arange(40)                                                  # decays within 8 s
     data = CouplingData("own", ("", ""), "b", "b", am, 0.2,
                         {(3, 3): np.exp(-1.5 * t), (5, 3): 0.3 * np.exp(-t) * np.cos(2.0 * t)})
-    c = Coupling.from_deck(data, method=method, tol=1e-5)
+    c = Coupling.from_deck(data, method=method, tol=1e-3)
     assert c.self_coupling and c.sides == ("A",) and c.source("A") == c.target("A") == "b"
     a = rng.normal(size=6)
     np.testing.assert_allclose(c.acceleration_load("A", a), -am @ a)          # applied once
     with pytest.raises(ValueError):
         c.mass("B")
     v = np.eye(6)[2]                                                          # own heave velocity
-    c = Coupling.from_deck(data, method=method, tol=1e-5, v0_a=v)
+    c = Coupling.from_deck(data, method=method, tol=1e-3, v0_a=v)
+    assert c.method == method   # (the fits reach 1.3e-4; below it: convolution)
     for _ in range(50):
         f = c.memory["A"].advance(0.2, v)
     expected = np.zeros(6)

@@ -335,3 +335,170 @@ def test_coupling_map_key_naming_no_deck_body_is_refused(tmp_path):
         'bodies = { BARGEA = "barge_a", BARGEB = "barge_b" }', 'bodies = { BARGEA = "barge_a", BARGE_B = "barge_b" }', 1)
     err = scene_error(tmp_path, text)
     assert err.field == "couplings[0].bodies.BARGE_B" and "did you mean 'BARGEB'" in err.message
+
+
+# --- issue 31's corpus, each by its class ----------------------------------------------------
+
+def wave_scene(folder, waves, bem="wave_cylinder.nc", coupling=False):
+    """A floating cylinder of the wave dataset (bench.waves_motions) under ``waves`` ([waves] body)."""
+    import xarray as xr
+    from hydrofmu.bench.waves_motions import body_table
+    data = ROOT / "tests" / "data" / "bem"
+    for f in (bem, "wave_cylinder.nc"):
+        if not (folder / f).exists():
+            shutil.copy(data / f, folder / f)
+    m = float(xr.load_dataset(folder / bem)["inertia_matrix"].values[0, 0])
+    text = f"[waves]\n{waves}\n" + body_table("cyl", m, 0.0, bem)
+    if coupling:
+        text += f'\n[[couplings]]\nbem = "{bem}"\nbodies = {{ cyl = "cyl" }}\n'
+    path = folder / "w.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("scene_depth, file_depth, said", [
+    (None, 50.0, "water depth 50 m in the BEM result but deep water (inf) in the scene"),
+    (50.0, float("inf"), "water depth deep water (inf) in the BEM result but 50 m in the scene"),
+    (50.0, 60.0, "water depth 60 m in the BEM result but 50 m in the scene"),
+])
+@pytest.mark.parametrize("coupling", [False, True])
+def test_bem_depth_differing_from_the_scene_is_refused(tmp_path, capsys, scene_depth, file_depth, said, coupling):
+    """Before: a dataset at 50 m in a scene without depth built as deep water (|50 − ∞| ≤ 1e-6·∞
+    holds); the radiation couplings were never compared at all."""
+    xr = pytest.importorskip("xarray")
+    ds = xr.load_dataset(ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc").assign_coords(water_depth=file_depth)
+    ds.to_netcdf(tmp_path / "d.nc")
+    if coupling:   # the excitation agrees with the scene: only the coupling's file differs
+        shutil.copy(ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc", tmp_path / "wave_cylinder.nc")
+    waves = 'spectrum = "regular"\nheight = 1.0\nperiod = 8.0' + ("" if scene_depth is None else f"\ndepth = {scene_depth}")
+    if coupling and scene_depth is not None:
+        xr.load_dataset(tmp_path / "wave_cylinder.nc").assign_coords(water_depth=scene_depth).to_netcdf(
+            tmp_path / "same.nc")
+    path = wave_scene(tmp_path, waves, bem="d.nc" if not coupling else
+                      ("same.nc" if scene_depth is not None else "wave_cylinder.nc"), coupling=False)
+    if coupling:
+        path.write_text(path.read_text() + '\n[[couplings]]\nbem = "d.nc"\nbodies = { cyl = "cyl" }\n')
+    line = refused(capsys, ["build", "--check", path])
+    assert said in line and ("couplings[0].bem" in line if coupling else "effects[0].bem" in line), line
+
+
+@pytest.mark.parametrize("waves, key, said", [
+    ('spectrum = "jonswap"\nhs = 2000.0\ntp = 8.0', "waves.hs", "2000 m is beyond any sea"),
+    ('spectrum = "regular"\nheight = 150.0\nperiod = 8.0', "waves.height", "150 m is beyond any sea"),
+    ('spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 1e17', "waves.components",
+     "1e+17 wave components would need"),
+])
+def test_sea_values_beyond_any_sea_or_memory_are_exit_2(tmp_path, capsys, waves, key, said):
+    """Before: hs = 2000 (mm meant) built without a word; components = 1e17 ended in a
+    MemoryError, exit 3.  Now one error naming the key, before anything is allocated."""
+    path = wave_scene(tmp_path, waves)
+    line = refused(capsys, ["build", "--check", path])
+    assert f"{key}: " in line and said in line, line
+
+
+@pytest.mark.parametrize("waves, key, said", [
+    ('spectrum = "regular"\nheight = 1.0\nperiod = 8.0\nhs = 2.0\ntp = 9.0', "waves.hs",
+     "hs, tp are not read by spectrum = 'regular'"),
+    ('spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\nheight = 1.0', "waves.height", "height is not read by spectrum = 'jonswap'"),
+    ('spectrum = "pierson_moskowitz"\nhs = 2.0\ntp = 8.0\ngamma = 2.0', "waves.gamma",
+     "gamma is not read by spectrum = 'pierson_moskowitz'"),
+    ('spectrum = "regular"\nheight = 1.0\nperiod = 45.0', "waves.period", "45 s is outside 1…40 s"),
+    ('spectrum = "regular"\nheight = 6.0\nperiod = 1.6', "waves.height", "steeper than the breaking limit"),
+])
+def test_sea_keys_ignored_or_odd_are_said(tmp_path, waves, key, said):
+    """Before: hs and tp given for a regular wave were ignored without a word."""
+    from hydrofmu.errors import InputWarning
+    path = wave_scene(tmp_path, waves)
+    with pytest.warns(InputWarning) as caught:
+        try:
+            load_scene(path)
+        except InputError:
+            pass     # a period outside the transfer functions is the build's error; the warning came first
+    assert any(f"{key}: " in str(w.message) and said in str(w.message) for w in caught), [str(w.message) for w in caught]
+
+
+def test_sea_thresholds_by_hand():
+    """The thresholds of admissible.sea_problems at their edges (documented in docs/waves.md)."""
+    from hydrofmu.admissible import HS_MAX, sea_problems
+    assert sea_problems("jonswap", {"hs": HS_MAX, "tp": 15.0}) == ([], [])
+    assert [k for k, _ in sea_problems("jonswap", {"hs": HS_MAX + 0.1, "tp": 15.0})[0]] == ["hs"]
+    assert [k for k, _ in sea_problems("jonswap", {"hs": 0.1, "tp": 0.9})[1]] == ["tp"]
+    assert sea_problems("jonswap", {"hs": 0.1, "tp": 1.0})[1] == []
+    # deep water, T = 2 s: L = g·T²/2π = 6.245 m, the breaking height L/7 = 0.892 m
+    assert sea_problems("regular", {"height": 0.89, "period": 2.0})[1] == []
+    assert [k for k, _ in sea_problems("regular", {"height": 0.90, "period": 2.0})[1]] == ["height"]
+
+
+def test_riflex_conb_codes_written_as_words_are_refused(tmp_path):
+    """Before: 'FIX FIX FREE' was taken for another data group and skipped: a ball joint
+    instead of the hinge written.  The manual's codes are 0 and 1."""
+    from hydrofmu.decks.riflex import read_components
+    deck = tmp_path / "c.inp"
+    for codes, field in (("FIX FIX FREE", "IRX"), ("fixed", "IRX"), ("1 FIX 0", "IRY"), ("0 0 free", "IRZ")):
+        deck.write_text(f"NEW COMPonent CONB\nhinge\n100.0 0.1\nGLOBAL 0 0 0 0 0 0\n{codes}\nEND\n")
+        with pytest.raises(InputError) as err:
+            read_components(deck)
+        assert (err.value.path, err.value.line, err.value.field) == (str(deck), 5, field), err.value
+    deck.write_text("NEW COMPonent CONB\nhinge\n100.0 0.1\nGLOBAL 0 0 0 0 0 0\n1 1 0\nEND\n")
+    assert read_components(deck)["hinge"].codes == (1, 1, 0)
+
+
+@pytest.mark.parametrize("table, field, said", [
+    ('[matrix]\n"environment.current_speed" = [0.5, "fast"]\n', "matrix.environment.current_speed",
+     "value 'fast' is not a number"),
+    ('[matrix]\n"barge.rho" = ["fast"]\n', "matrix.barge.rho", "value 'fast' is not a number"),
+    ('[matrix]\n"bodies.barge.mass" = [1.0e6, "fast"]\n', "matrix.bodies.barge.mass",
+     "value 'fast' is a string among numbers"),
+    ('[[cases]]\n"barge.rho" = "fast"\n', "cases[0].barge.rho", "value 'fast' is not a number"),
+])
+def test_batch_value_that_is_not_a_number_is_refused_before_any_case(tmp_path, table, field, said):
+    """Before: the cases ran, then writing cases.parquet ended in an ArrowTypeError, exit 3."""
+    cases = tmp_path / "cases.toml"
+    cases.write_text(BASE + table)
+    with pytest.raises(InputError) as err:
+        load_cases(cases)
+    assert err.value.path == str(cases) and err.value.field == field and said in err.value.message
+
+
+def test_batch_first_value_the_scene_refuses_is_the_batch_error(tmp_path):
+    """A knob value every case would trip over (all strings for a number) is said before any case."""
+    cases = tmp_path / "cases.toml"
+    cases.write_text(BASE + '[matrix]\n"bodies.barge.mass" = ["fast", "slow"]\n')
+    with pytest.raises(InputError) as err:
+        check_knobs(load_cases(cases))
+    assert err.value.field == "bodies.barge.mass" and "value 'fast'" in err.value.message
+
+
+def test_run_rows_beyond_memory_are_refused_before_the_run(demo_build, monkeypatch):
+    """The rows of a run without a file sink are one array: more than the machine holds is
+    an error naming run.stop before it is allocated (was a MemoryError, exit 3)."""
+    from hydrofmu import admissible
+    from hydrofmu.cosim.master import run
+    monkeypatch.setattr(admissible, "memory_bytes", lambda: 1000)
+    with pytest.raises(InputError) as err:
+        run(demo_build, stop=1.0)
+    assert err.value.field == "run.stop" and "output values would need" in err.value.message
+
+
+def test_components_beyond_the_compiled_limit_are_refused(tmp_path):
+    """More components than physics/waves.c takes (1e7) is the scene's error for both flavours."""
+    with pytest.raises(InputError) as err:
+        load_scene(wave_scene(tmp_path, 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 20000000'))
+    assert "waves.components: 2e+07 wave components: more than 1e+07" in str(err.value)
+
+
+@pytest.mark.parametrize("knob, said", [
+    ('"waves.hs" = [2.0, 2000.0]', "value 2000.0: 2000 m is beyond any sea"),
+    ('"waves.components" = [100, 1.0e17]', "value 1e+17: 1e+17 wave components would need"),
+])
+def test_batch_sea_knobs_beyond_a_sea_are_refused_before_any_case(tmp_path, knob, said):
+    """waves.* knobs are FMU parameters: the scene's checks never see them; the batch checks
+    each value against the scene's [waves] before any case runs."""
+    shutil.copy(ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc", tmp_path / "wave_cylinder.nc")
+    scene = wave_scene(tmp_path, 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0')
+    cases = tmp_path / "cases.toml"
+    cases.write_text(f'scene = "w.toml"\nstop = 10.0\noutputs = ["cyl.waves.force[3]"]\n[matrix]\n{knob}\n')
+    assert scene.exists()
+    with pytest.raises(InputError) as err:
+        check_knobs(load_cases(cases))
+    assert err.value.field == knob.split('"')[1] and said in err.value.message, err.value

@@ -126,3 +126,90 @@ def whole_interval(interval, step):
         return 1, [("interval", f"the output interval must be a whole number of steps ({step:g} s), "
                                 f"found {interval:g} s")]
     return int(every), []
+
+
+def _depth(value):
+    return "deep water (inf)" if math.isinf(value) else f"{value:g} m"
+
+
+def depth_mismatch(file_depth, scene_depth, rel=1e-6):
+    """A message when a BEM result's water depth is not the scene's (both [m], inf: deep
+    water), else None.  Infinite and finite never match: |50 − ∞| ≤ 1e-6·∞ is no test."""
+    if file_depth is None or scene_depth is None:
+        return None
+    if math.isinf(file_depth) or math.isinf(scene_depth):
+        same = math.isinf(file_depth) and math.isinf(scene_depth)
+    else:
+        same = abs(file_depth - scene_depth) <= rel * scene_depth
+    return None if same else f"water depth {_depth(file_depth)} in the BEM result but {_depth(scene_depth)} in the scene"
+
+
+# What a sea can be (issue 31): beyond these a value is a slip (millimetres for metres, a
+# frequency for a period), said naming the key.  Errors: no sea state on record has Hs near
+# 30 m (the largest measured are about 20 m) and no wave is 60 m high; warnings: periods
+# outside 1…40 s are legal (model-basin scale, long swell) but rarely meant, and a wave steeper
+# than the breaking limit H/L = 1/7 (L of its period and depth) is beyond linear theory.
+HS_MAX = 30.0            # m: significant wave height, error above
+HEIGHT_MAX = 60.0        # m: regular wave height, error above
+PERIOD_RANGE = (1.0, 40.0)   # s: Tp and the regular period, warning outside
+BREAKING = 1 / 7         # H/L: regular waves (Hs/Lp for spectra), warning above
+
+# the keys each spectrum reads ([waves]); the others are ignored by it (a warning names them)
+WAVE_KEYS_USED = {
+    "regular": {"height", "period", "phase", "direction", "ramp", "depth"},
+    "jonswap": {"hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp", "depth"},
+    "pierson_moskowitz": {"hs", "tp", "direction", "spreading", "components", "seed", "ramp", "depth"},
+}
+for _used in WAVE_KEYS_USED.values():   # the kinematics' keys: every spectrum reads them
+    _used |= {"stretching", "points"}
+
+
+def sea_problems(spectrum, values, g=9.81):
+    """(errors, warnings) of a sea state's values (``values``: key → number, the [waves]
+    knobs): each a list of (key, message); see HS_MAX … BREAKING."""
+    from .physics.waves import wave_number
+    errors, warns = [], []
+    regular = spectrum == "regular"
+    h_key, t_key = ("height", "period") if regular else ("hs", "tp")
+    h, t = values.get(h_key), values.get(t_key)
+    limit = HEIGHT_MAX if regular else HS_MAX
+    if h is not None and h > limit:
+        errors.append((h_key, f"{h:g} m is beyond any sea ({'a regular wave' if regular else 'Hs'} above {limit:g} m): "
+                              "millimetres or centimetres written for metres?"))
+    if t is not None and t > 0 and not PERIOD_RANGE[0] <= t <= PERIOD_RANGE[1]:
+        warns.append((t_key, f"{t:g} s is outside {PERIOD_RANGE[0]:g}…{PERIOD_RANGE[1]:g} s, the periods of sea waves "
+                             "at full scale: a frequency written for a period, or a model-scale sea?"))
+    if h is not None and t is not None and h > 0 and t > 0 and not errors:
+        depth = values.get("depth", math.inf)
+        length = 2 * math.pi / float(wave_number(2 * math.pi / t, g, depth))
+        if h / length > BREAKING:
+            warns.append((h_key, f"{h:g} m in a wave {length:.3g} m long ({t_key} = {t:g} s): steeper than the breaking "
+                                 f"limit H/L = 1/7 (H/L = {h / length:.2f}); linear waves do not hold there"))
+    return errors, warns
+
+
+def ignored_wave_keys(spectrum, given):
+    """The keys of ``given`` (a [waves] table's keys) the spectrum does not read."""
+    used = WAVE_KEYS_USED.get(spectrum, set()) | {"spectrum"}
+    return sorted(k for k in given if k not in used)
+
+
+def memory_bytes():
+    """The machine's physical memory [bytes] (None when the system does not say)."""
+    import os
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def size_problem(count, bytes_each, what):
+    """A message when ``count`` items of ``bytes_each`` bytes (an allocation a size key asks
+    for) cannot fit in the machine's memory, else None: said before anything is allocated,
+    instead of a MemoryError."""
+    total = float(count) * float(bytes_each)
+    limit = memory_bytes() or 2.0 ** 40
+    if not math.isfinite(total) or total > limit:
+        return (f"{count:.4g} {what} would need {total / 2 ** 30:.3g} GiB, more than this machine's "
+                f"{limit / 2 ** 30:.3g} GiB of memory")
+    return None

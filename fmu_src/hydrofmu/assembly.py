@@ -70,15 +70,34 @@ def wave_window(scene):
 
 
 def body_waves(scene, body):
-    """description.Waves of a body, or None (no [waves] in the scene, or no excitation)."""
+    """description.Waves of a body, or None (no [waves] in the scene, or nothing on this body
+    feels them: no excitation, no effect that feels the kinematics, no named point).  Global
+    named points go to the first body's load FMU."""
+    from .scene.waves import feels_waves
+    if scene.waves is None:
+        return None
     eff = next((e for e in body.effects if e.type == "wave_excitation"), None)
-    if scene.waves is None or eff is None:
+    kinematics = any(feels_waves(e) for e in body.effects if e.type not in TIMED)
+    first = next(iter(scene.bodies)) == body.name
+    points = {n: ({"offset": list(p["offset"])} if "body" in p else {"position": list(p["position"])})
+              for n, p in scene.wave_points.items() if p.get("body") == body.name or ("position" in p and first)}
+    if eff is None and not kinematics and not points:
         return None
     sea = {k: v for k, v in vars(scene.waves).items() if k != "spectrum"}
+    if eff is None:
+        return d.Waves(None, scene.waves.spectrum, sea, wave_window(scene), kinematics=kinematics, points=points)
     dat = eff.data
     return d.Waves(eff.name, scene.waves.spectrum, sea, wave_window(scene), np.array(dat["omega"]),
                    np.array(dat["directions"]), np.array(dat["re"]), np.array(dat["im"]),
-                   np.array(body.position[:2], float))
+                   np.array(body.position[:2], float), kinematics, points)
+
+
+def joint_waves(scene):
+    """description.Waves of a CONB joint's connector FMU (its node feels the kinematics), or None."""
+    if scene.waves is None:
+        return None
+    sea = {k: v for k, v in vars(scene.waves).items() if k != "spectrum"}
+    return d.Waves(None, scene.waves.spectrum, sea, wave_window(scene), kinematics=True)
 
 
 def body_drift(scene, body):
@@ -271,7 +290,7 @@ def _connector(scene, joint, exported, env):
                     f"{' '.join(map(str, joint.codes))}, scene {scene.name})",
         name=joint.name, accel_mode=joint.accel_mode, node=dict(joint.node),
         joint=joint_spring(scene, joint, exported), a=_pose(a), b=_pose(b) if b is not None else None,
-        environment=env)
+        environment=env, waves=joint_waves(scene))
     return Instance(joint.name, f"{scene.name}_{joint.name}", "joint", a.name, fmu, motion, forces)
 
 
@@ -294,10 +313,16 @@ def fit_memories(couplings):
     """Realise every state-space coupling's kernels once and store the fits in the coupling
     (``HydroCoupling.fits``, carried by the FMU descriptions that hold it): instantiation
     then only loads them.  The build calls this, not ``assemble``: a batch assembles every
-    case to tell its variants apart and must not pay the fits for it."""
+    case to tell its variants apart and must not pay the fits for it.  A coupling whose
+    realisation misses its tolerance (``physics.coupling.Coupling.fallback``, warned once
+    there) is stored as a convolution: the FMUs step what the build reported."""
     for c in couplings:
         if c.method == "state_space" and c.kernels and not c.fits:
-            c.fits = [d.Fit(i, j, f.A, f.B, f.C, f.error) for (i, j), f in sorted(c.model().fits.items())]
+            model = c.model()
+            if model.method == "convolution":
+                c.method = "convolution"
+                continue
+            c.fits = [d.Fit(i, j, f.A, f.B, f.C, f.error) for (i, j), f in sorted(model.fits.items())]
 
 
 def notes(scene, system):

@@ -93,7 +93,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
     t ≥ ``transient``.  fmpy runs stream their rows into the CSV and ``parquet`` (default:
     beside the CSV when pyarrow is installed) as they go, and the PNG and the summary are
-    read from the file; a libcosim run is written after it ends.  A write that fails after
+    read from the file; a libcosim run writes the same files after it ends.  A write that fails after
     the run goes to a fallback folder: ``written`` maps each asked path to the one written."""
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
@@ -106,8 +106,11 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
+    if parquet is None and csv is not None and _has_pyarrow():
+        parquet = Path(csv).with_suffix(".parquet")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
+        check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))
         say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
         try:
             result = run(folder, **kw)
@@ -116,19 +119,41 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         result.written = {}
         if csv:
             result.written[Path(csv)] = keep(result.to_csv, csv, log)[0]
+        if parquet:   # the files an fmpy run writes, written when the run ends
+            from .cosim.stream import write_parquet
+            result.written[Path(parquet)] = write_parquet(result, parquet, log)
         return _plot_and_summary(result, png, summary, transient, log)
     from .cosim.master import run
     from .cosim.stream import Sink
-    if parquet is None and csv is not None and _has_pyarrow():
-        parquet = Path(csv).with_suffix(".parquet")
     check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
+    from .cosim.master import RunError
     try:
         result = run(folder, sink=Sink(parquet, csv) if parquet or csv else None, **kw)
     except InputError as exc:   # the run's own --outputs/--interval, named as the command line says them
         raise _as_option(exc) from None
+    except RunError as exc:   # a run that failed keeps what it computed: its files, and the plot of them
+        _plot_partial(exc, manifest, png, log)
+        raise
     result.written = {Path(asked): Path(got) for asked, got in getattr(result, "written", {}).items()}
     return _plot_and_summary(result, png, summary, transient, log)
+
+
+def _plot_partial(exc, manifest, png, log):
+    """The plot of a failed run's rows up to the failure (kept by the master), said in its message."""
+    written = list(getattr(exc, "written", {}).values())
+    if not png or not written:
+        return
+    try:
+        from .cosim.result import read_csv
+        from .cosim.stream import read_parquet
+        got = written[-1]
+        partial = read_parquet(got) if str(got).endswith(".parquet") else read_csv(got, manifest)
+        if _unplotted(partial) is None and len(partial.time) > 1:
+            drawn = keep(partial.plot, png, log)[0]
+            exc.args = (exc.args[0] + f", the plot of them in {drawn}",)
+    except Exception as why:   # the failure's own message matters more than the plot's
+        log(f"warning: no plot of the failed run's rows ({type(why).__name__}: {why})")
 
 
 def _as_option(exc):
@@ -209,7 +234,7 @@ def validate(paths):
 
 
 def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_length=None,
-             symmetry_tolerance=None, png=None, log=print, a_inf="ogilvie"):
+             symmetry_tolerance=None, png=None, log=print, a_inf="ogilvie", period_variable=None):
     """A BEM result (Capytaine .nc, WAMIT .1) → a SIMO deck with every self and cross coupling
     of its bodies (BODY DATA groups first); the transform's report goes to ``log``."""
     from .bem import couplings, plot_quality, write_simo
@@ -224,7 +249,7 @@ def bem2simo(result, out, ulen=None, rho=None, dofs=None, timdel=None, kernel_le
                                                          "Capytaine dataset carries its own rho")
     rho = 1025.0 if rho is None else rho
     check_outputs(files=(out,), plots=(png,), inputs=(result,))
-    data = read_bem(result, ulen=ulen, rho=rho)
+    data = read_bem(result, ulen=ulen, rho=rho, g=9.81, period_variable=period_variable)
     made = couplings(data, {b: b for b in data.bodies}, dofs, timdel, kernel_length,
                      SYMMETRY_TOL if symmetry_tolerance is None else symmetry_tolerance, a_inf_from=a_inf)
     for line in made.report():
@@ -263,6 +288,7 @@ def tune(args):
     check_outputs(files=(args.scene,) if args.write else (), plots=(png,),
                   inputs=(*scene_files(args.scene), *(() if args.write else (args.scene,))))
     found = run_tune(args.scene, tolerance(args.tolerance), outputs=args.outputs, window=args.window,
+                     confirm=args.confirm,
                      repeats=args.repeats, png=png, log=lambda s: None)
     for line in found.report():
         print(line)
@@ -384,8 +410,11 @@ def make_parser():
     t.add_argument("--outputs", nargs="+", metavar="NAME",
                    help="what the error is measured on: body names, body.position (attitude, velocity, "
                         "acceleration) or instance.variable columns (default: every body's position and attitude)")
-    t.add_argument("--window", type=float, metavar="T", help="simulated time of each run [s] (default: the "
-                                                            "scene's stop, at most 60 s)")
+    t.add_argument("--window", type=float, metavar="T", help="simulated time of each search run [s] (default: "
+                                                            "the scene's stop, at most 60 s)")
+    t.add_argument("--confirm", type=float, metavar="T", help="length of the runs that confirm the choice [s], "
+                                                             "a whole number of windows (default: the scene's stop; "
+                                                             "shorter: the error's drift is checked)")
     t.add_argument("--repeats", type=int, default=3, help="interleaved timing rounds of the final candidates")
     t.add_argument("--png", type=Path, metavar="FILE", help="plot of the points run (default: build/tune/<scene>.png)")
     t.add_argument("--write", action="store_true", help="write the choice into the scene's [run] table (the rest "
@@ -420,8 +449,8 @@ def make_parser():
                                    "10 minutes in full.")
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
-                   choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "bem",
-                            "robust", "batch", "ecco", "longrun", "waves", "drift"),
+                   choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "hold", "bem",
+                            "robust", "batch", "ecco", "longrun", "waves", "kinematics", "drift"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="a smoke run of the cheaper parts at small sizes (about a minute of CPU; the "
                         "parts it leaves out are named), not the documented figures")
@@ -440,6 +469,9 @@ def make_parser():
     m.add_argument("--symmetry-tolerance", type=float, help="A∞ asymmetry tolerance (default 0.01)")
     m.add_argument("--a-inf", choices=("ogilvie", "file"), default="ogilvie",
                    help="A∞ from Ogilvie's relation, consistent with the kernels (default), or the file's ω = ∞ value")
+    m.add_argument("--period-variable", choices=("period", "omega", "wavenumber", "hz"),
+                   help="WAMIT: what the file's first column is, as the run's IPEROUT wrote it (default period; "
+                        "wavenumber: KL = ω²L/g with g = 9.81)")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
     d = sub.add_parser("meandrift", formatter_class=fmt,
                        help="add Capytaine's far-field mean drift to a Capytaine dataset (needs the bem-solve extra)",
@@ -464,9 +496,16 @@ def main(argv=None):
     """The command line; returns the exit code: 0 done, 1 a run or validation failed,
     2 bad input (one ``error:`` line naming the file, line or key path and field),
     3 an internal error (one line; HYDROFMU_DEBUG=1 shows the traceback)."""
+    _SAID.clear()
     with warnings.catch_warnings():
         warnings.simplefilter("always", InputWarning)
-        warnings.showwarning = _show_warning
+        said = set()   # each warning once per command: `tune` and `batch` read the scene again per case
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if str(message) not in said:
+                said.add(str(message))
+                _show_warning(message, category, filename, lineno, file, line)
+        warnings.showwarning = show
         try:
             return _main(argv)
         except InputError as exc:
@@ -483,11 +522,20 @@ def main(argv=None):
             return 3
 
 
+# the warnings this command said: each once, however often the scene is read (tune and batch
+# read it once per candidate or variant)
+_SAID = set()
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    if issubclass(category, InputWarning):
-        print(f"warning: {message}", file=sys.stderr)
-    else:
-        print(f"warning: {category.__name__}: {message}", file=sys.stderr)
+    _say_warning(f"warning: {message}" if issubclass(category, InputWarning) else
+                 f"warning: {category.__name__}: {message}")
+
+
+def _say_warning(text):
+    if text not in _SAID:
+        _SAID.add(text)
+        print(text, file=sys.stderr)
 
 
 def _main(argv):
@@ -505,6 +553,8 @@ def _main(argv):
         if reuse is not None:
             folder = reuse
             print(f"reusing {folder}: the scene, its decks and hydrofmu are unchanged since it was built")
+            for text in read_manifest(folder).get("warnings", []):   # the build's: said again, once
+                _say_warning(f"warning: {text}")
         elif folder.suffix == ".toml":
             from .scene import load_scene
             scene = load_scene(folder)
@@ -548,7 +598,7 @@ def _main(argv):
         return code
     elif args.command == "bem2simo":
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
-                        args.symmetry_tolerance, args.png, a_inf=args.a_inf)
+                        args.symmetry_tolerance, args.png, a_inf=args.a_inf, period_variable=args.period_variable)
         return _wrote(made)[1]
     elif args.command == "meandrift":
         from .bem_drift import add_mean_drift

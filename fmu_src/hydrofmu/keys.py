@@ -104,18 +104,22 @@ EFFECT_COMMON = {
 EFFECTS = {
     "aqwa_viscous_drag": {
         "deck": {"deck": (STRING, "AQWA input file, relative to the scene"),
-                 "body": (STRING, "FLOATING BODY name in the deck")},
+                 "body": (STRING, "FLOATING BODY name in the deck"),
+                 "waves": ({"type": "boolean"}, "our extension: the relative velocity also subtracts the incident waves' velocity")},
         "inline": {"matrix": (matrix(6), "6×6 drag matrix V (or 6 diagonal values), body axes"),
-                   "option": (enum("ABSOLUTE", "RELATIVE"), "RELATIVE: velocity relative to the current")},
+                   "option": (enum("ABSOLUTE", "RELATIVE"), "RELATIVE: velocity relative to the current"),
+                   "waves": ({"type": "boolean"}, "our extension: the relative velocity also subtracts the incident waves' velocity")},
     },
     "deeplines_current_polar": {
         "deck": {"deck": (STRING, "DeepLines data file, relative to the scene"),
                  "structure": (STRING, "*CURRENTPOL,NAME= of the structure"),
-                 "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+                 "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table"),
+                 "waves": ({"type": "boolean"}, "our extension: the current also subtracts the incident waves' velocity")},
         "inline": {"point": (vector(3), "current centre (XC, YC, ZC) [m], body axes"),
                    "surface": (POSITIVE, "reference surface SURFC [m2]"),
                    "table": (ROWS, "[[angle deg, CX, CY, CMZ m], …]"),
-                   "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+                   "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table"),
+                   "waves": ({"type": "boolean"}, "our extension: the current also subtracts the incident waves' velocity")},
     },
     "riflex_body": {
         "deck": {"offset": (vector(3), "attachment point [m], body axes from the reference point"), **COMPONENT},
@@ -123,6 +127,9 @@ EFFECTS = {
     },
 }
 
+PERIOD_VARIABLE = (enum("period", "omega", "wavenumber", "hz"),
+                   "WAMIT: the first column of the file, as the run's IPEROUT wrote it: period [s] (default), "
+                   "omega [rad/s], wavenumber (KL = ω²L/g), hz [Hz]")
 BEM_EFFECT = {
     "bem": (STRING, "Capytaine dataset (.nc), or WAMIT file, relative to the scene"),
     "body": (STRING, "BEM body (optional for a one-body file; WAMIT: body1, body2, …)"),
@@ -130,7 +137,8 @@ BEM_EFFECT = {
 }
 # effects whose data always come from a BEM result: no deck variant (an empty one never matches)
 EFFECTS["wave_excitation"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "excitation: Capytaine dataset "
-                                                                                  "(.nc) or WAMIT .3 / .2")}}
+                                                                                  "(.nc) or WAMIT .3 / .2"),
+                                                     "period_variable": PERIOD_VARIABLE}}
 EFFECTS["bem_hydrostatics"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "hydrostatics: Capytaine dataset "
                                                                                    "(.nc) or WAMIT .hst")}}
 
@@ -155,9 +163,20 @@ WAVES = {
     "spreading": (NONNEG, "cos-2s spreading exponent s (0: long-crested)"),
     "components": ({"type": "integer", "minimum": 1}, "number of wave components (default 200)"),
     "seed": ({"type": "integer", "minimum": 0}, "random seed of frequencies, phases, directions"),
-    "ramp": (NONNEG, "length of the smooth start ramp [s]"),
+    "ramp": (NONNEG, "length of the smooth start ramp [s] (default: 3 peak periods; 0: none)"),
     "depth": (POSITIVE, "water depth [m] (default: deep water)"),
+    "stretching": (enum("none", "vertical", "wheeler", "extrapolation"),
+                   "wave kinematics above the mean water level (default wheeler)"),
 }
+WAVE_POINT = {
+    "position": (vector(3), "a fixed point [m], global (outputs on the first body's load FMU)"),
+    "body": (STRING, "the body carrying the point (outputs on its load FMU)"),
+    "offset": (vector(3), "the point on the body [m], body axes from its reference point"),
+}
+WAVES["points"] = ({"type": "object", "additionalProperties": {
+    "type": "object", "additionalProperties": False,
+    "properties": {k: dict(v[0], description=v[1]) for k, v in WAVE_POINT.items()}}},
+    "named points whose wave kinematics are FMU outputs waves.<point>.*: [waves.points.NAME]")
 
 BODY = {
     "position": (vector(3), "initial (equilibrium) position of the reference point [m], global"),
@@ -206,6 +225,7 @@ BEM_COUPLING = {
     "name": (NAME, "prefix of the couplings' names (default \"bem\")"),
     "dofs": (NAMES, "dofs to keep, e.g. [\"Surge\", \"Heave\", \"Pitch\"] (default: all)"),
     "ulen": (POSITIVE, "WAMIT: the length ULEN [m]"),
+    "period_variable": PERIOD_VARIABLE,
     "timdel": (POSITIVE, "kernel spacing [s] (default from the grid)"),
     "kernel_length": (POSITIVE, "kernel length [s] (default from the grid)"),
     "symmetry_tolerance": (POSITIVE, "A∞ asymmetry allowed, relative to √(A_ii·A_jj)"),

@@ -14,6 +14,8 @@ Parts (each also callable alone, see ``PARTS``):
 - startup: load, instantiate and initialise (and free) every scene of models/ again in a
   running process, against the pythonfmu floor (``startup``)
 - stability: added-mass stability map, explicit against export (``stability``)
+- hold: the load hold against light damping: free decays against Δζ of ``physics.hold``,
+  every scene of models/ and the cylinder in a sea with each hold and step (``hold``)
 - bem: the BEM transform (A(ω), B(ω) → A∞, K(t)) against dofs and frequencies (``radiation_cost``)
 - robust: time to report one bad number near the end of a 50 MB deck against reading it
   good; memory over fmi2Instantiate/fmi2FreeInstance cycles with and without the shim's
@@ -27,6 +29,9 @@ Parts (each also callable alone, see ``PARTS``):
   1000 components, and per 100 components (``waves_cost``); the floating cylinder's and the
   pair's motions in regular waves next to their lightly damped resonances, long runs at
   several steps, against the frequency domain (``waves_motions``)
+- kinematics: the shared wave phasors (the `waves` kernel per component per step, against cos/sin
+  every step) and the incident-wave kinematics per point per step against the `waves` kernel, at
+  50, 200, 1000 components, Python and compiled flavours (``kinematics_cost``)
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
   case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
   took against the bonds' power (``ecco_cost``)
@@ -47,7 +52,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from . import compiled, cosim_cost, floor, memory_cost, native, overhead, radiation_cost, robust  # noqa: E402
-from . import stability, startup  # noqa: E402
+from . import hold, stability, startup  # noqa: E402
 from . import waves_cost  # noqa: E402
 from .timing import over  # noqa: E402
 
@@ -435,6 +440,14 @@ def part_stability(out, quick):
     return [f"added-mass map: {csv_path.name}, {png.name}"]
 
 
+def part_hold(out, quick):
+    d = hold.decay(out, steps=(0.1,) if quick else (0.05, 0.1, 0.2))
+    write_csv(out / "hold_decay.csv", d)
+    s = hold.scenes(out, stop=60.0 if quick else 600.0, factors=(1,) if quick else (1, 2))
+    write_csv(out / "hold_scenes.csv", s)
+    return hold.summary(d, s)
+
+
 def part_bem(out, quick):
     sizes = ((12, 50), (12, 100)) if quick else ((12, 50), (12, 100), (12, 200), (24, 100))
     rows = radiation_cost.measure(sizes, rounds=2 if quick else 5)
@@ -530,6 +543,11 @@ def part_waves(out, quick):
         return [f"skipped: needs {waves_cost.DATA} (a repository checkout)"]
     write_csv(out / "waves.csv", rows)
     lines = waves_lines(rows)
+    from . import kinematics_cost   # the shared phasors: the kernel per component, both flavours
+    table = kinematics_cost.rows(kinematics_cost.python_costs(calls=300 if quick else 2000, rounds=2 if quick else 5),
+                                 kinematics_cost.compiled_costs(steps=2000 if quick else 20000,
+                                                                rounds=2 if quick else 5))
+    lines += [line for line in kinematics_cost.lines(table) if "kinematics per point" not in line]
     from . import waves_motions
     motions = waves_motions.measure(out / "waves_motions", quick)
     if motions:
@@ -537,6 +555,18 @@ def part_waves(out, quick):
         lines += ["motions in regular waves, radiation damping only, against X(ω) of the dataset (% of each dof's "
                   "peak |X|): " + line for line in waves_motions.summary(motions)]
     return lines
+
+
+def part_kinematics(out, quick):
+    """The wave phasors and the incident-wave kinematics per step, Python and compiled flavours."""
+    from . import kinematics_cost
+    python = kinematics_cost.python_costs(calls=300 if quick else 2000, rounds=2 if quick else 5)
+    compiled = kinematics_cost.compiled_costs(steps=2000 if quick else 20000, rounds=2 if quick else 5)
+    table = kinematics_cost.rows(python, compiled)
+    write_csv(out / "kinematics.csv", table)
+    clump = kinematics_cost.joined_barges_clump(out / "kinematics", stop=60.0 if quick else 200.0)
+    png = kinematics_cost.plot_clump(clump, out / "clump_in_waves.png")
+    return kinematics_cost.lines(table) + [f"the joined barges' clump with and without waves: {png.name}"]
 
 
 def waves_lines(rows):
@@ -575,8 +605,9 @@ def part_drift(out, quick):
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "startup": part_startup, "stability": part_stability,
+         "hold": part_hold,
          "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves,
-         "drift": part_drift}
+         "kinematics": part_kinematics, "drift": part_drift}
 
 
 # --quick without --part: the parts whose quick size costs under ~12 s of CPU each (measured

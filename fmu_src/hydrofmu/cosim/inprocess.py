@@ -10,6 +10,7 @@ Unlike a build, it leaves the dynamics' load inputs starting at zero (``fmi.star
 evaluate every load slave once more): the master exchanges in initialization mode, so a
 run is the same.
 """
+import sys
 import tempfile
 from pathlib import Path
 
@@ -73,6 +74,9 @@ class Local:
         the FMICallException fmpy raises for fmi2Error, the messages kept in ``errors``."""
         queue = self.slave.log_queue
         errors = [m.msg for m in queue if m.status in (Fmi2Status.error, Fmi2Status.fatal)]
+        for m in queue:   # warnings as the fmpy master's logger shows them
+            if m.status == Fmi2Status.warning:
+                sys.stderr.write(f"[WARNING] {m.msg}\n")
         queue.clear()
         if errors or result is False:
             self.errors += errors

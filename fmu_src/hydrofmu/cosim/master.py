@@ -26,7 +26,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
-from ..admissible import whole_steps
+from ..admissible import size_problem, whole_steps
 from ..errors import InputError
 from ..names import unknown
 from .manifest import read_manifest
@@ -45,12 +45,14 @@ def run_settings(manifest, step=None, algorithm=None, stop=None):
     cfg = manifest["run"]
     out = {k: cfg.get(k) for k in ("preset", "step", "stop", "algorithm", "substep", "load_hold")}
     out["set"] = list(cfg.get("set", []))
+    out["chosen"] = list(cfg.get("chosen", []))   # defaults chosen for what the scene holds (scene.run)
     for key, value in (("step", step), ("algorithm", algorithm), ("stop", stop)):
         if value is not None and value != out[key]:
             out[key] = value
             # the run's value replaces the scene's in the list too ("stop (run)", not "stop, stop (run)")
             out["set"] = [k for k in out["set"] if k != key] + [f"{key} (run)"]
     out["couplings"] = manifest.get("couplings", {})
+    out["flavour"] = manifest.get("flavour")   # 'python' or 'c': which FMUs ran
     if out["algorithm"] == "ecco":
         from ..scene import ECCO_DEFAULTS
         out["ecco"] = {**ECCO_DEFAULTS, **(cfg.get("ecco") or {})}
@@ -73,7 +75,10 @@ def describe(settings):
             + f"{'first ' if ecco else ''}step {settings['step']:g} s, {algorithm}, "
             f"{settings['load_hold']} load hold, substep {settings['substep']:g} s"
             + (f"; set by the scene/run: {', '.join(settings['set'])}" if settings["set"] else "")
-            + (f"; memory {memory}" if memory else ""))
+            + (f"; chosen for the scene: {', '.join(settings['chosen'])}" if settings.get("chosen") else "")
+            + (f"; memory {memory}" if memory else "")
+            + {"python": "; Python flavour (pythonfmu FMUs)", "c": "; compiled flavour (C FMUs)"}.get(
+                settings.get("flavour"), ""))
 
 
 _descriptions = {}   # unzipped FMU folder (named by its content) -> its model description
@@ -384,7 +389,7 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         _check_algorithm(algorithm or manifest["run"]["algorithm"], folder)
         _check_parameters(parameters or {}, manifest)
     system = load(folder, parameters) if own else folder
-    t = 0.0
+    t, rows, settings = 0.0, None, None
     try:
         cfg = system.manifest["run"]
         stop = cfg["stop"] if stop is None else stop
@@ -414,6 +419,11 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
                                             if c == "parameter" or (c == "input" and f"{name}.{v}" not in connected)],
                         "run", "parameters", "parameter or unconnected input")
         settings = run_settings(system.manifest, step, algorithm, stop)
+        too_big = None if sink is not None else size_problem((n // thin + 1) * (len(record) + 1), 8, "output values")
+        if too_big:   # the rows are one array in memory: said before it is allocated, not a MemoryError
+            raise InputError(system.manifest.get("source", "run"), None, "run.stop",
+                             f"{too_big} ({n // thin + 1:.4g} rows of {len(record)} outputs): record fewer outputs "
+                             "(run.outputs), a coarser run.interval, a shorter run.stop, or write to a file (--csv)")
         rows = Recorder(n, step, len(record), thin, sink)
         if sink is not None:
             sink.open(record, system.units(record), system.manifest, {**settings, "output_interval": thin * step})
@@ -465,7 +475,21 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
         return Result(np.arange(0, n + 1, thin) * step, list(record), rows.values, algorithm, thin * step,
                       system.manifest["dynamics"], settings, system.units(record), system.manifest)
     except FMICallException as exc:
-        raise RunError(failure(system, exc, t)) from None
+        err = RunError(failure(system, exc, t) + advice(system.manifest["run"], settings, stop))
+        # what the run computed up to the failure is kept: the rows streamed so far (in place of
+        # the files asked for, said in the message), else the rows in memory (``err.partial``)
+        err.partial, err.written = None, {}
+        if rows is not None and sink is not None:
+            rows.flush()
+            sink.close()
+            err.written, sink = dict(sink.written), None
+            err.args = (err.args[0] + f"; the results up to t = {t:g} s are kept in "
+                        + ", ".join(str(p) for p in err.written.values()),)
+        elif rows is not None and rows.used:
+            err.partial = Result(rows.time[:rows.used].copy(), list(record), rows.values[:rows.used].copy(), algorithm,
+                                 thin * step, system.manifest["dynamics"], settings, system.units(record),
+                                 system.manifest)
+        raise err from None
     finally:
         if sink is not None:   # the run failed: no half-written file under the asked name
             sink.close(ok=False)
@@ -474,6 +498,34 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
 
 
 _STATUS = {1: "warning", 2: "discard", 3: "error", 4: "fatal"}
+
+
+def advice(cfg, settings, stop):
+    """The likely cause of a failed run and the knob that would have held it (docs/tuning.md):
+    the constant load hold (its half-step lag drives modes whose restoring is a load input),
+    a step past the linear hold's damping budget, no ramp on the waves."""
+    from ..physics.hold import damping_change, stable_step
+    if not settings:
+        return ""
+    tips = []
+    omega = cfg.get("restoring_omega")
+    hold, step = settings["load_hold"], settings["step"]
+    if hold == "constant" and (omega or cfg.get("waves") or settings.get("couplings")):
+        lag = f" (−{100 * -float(damping_change(omega, step, 'constant')):.2g} % of critical at {omega:.3g} rad/s)" \
+            if omega else ""
+        tips.append(f'[run] load_hold = "linear": the constant hold lags the loads by half a step and takes '
+                    f"ω·h/4 of critical damping from every mode whose restoring is a load input{lag}, more than "
+                    "radiation gives roll and pitch")
+    if omega and hold == "linear":
+        good = stable_step(omega, stop or cfg["stop"])
+        if good < step:
+            tips.append(f"[run] step = {good:g}: at {step:g} s the linear hold takes "
+                        f"{100 * -float(damping_change(omega, step, 'linear')):.2g} % of critical damping at "
+                        f"{omega:.3g} rad/s")
+    waves = cfg.get("waves")
+    if waves and not waves.get("ramp"):
+        tips.append(f"[waves] ramp = {3 * waves['period']:g}: a start without a ramp kicks the body")
+    return ("; likely cause and the knob that would have held it: " + "; or ".join(tips)) if tips else ""
 
 
 def failure(system, exc, t):

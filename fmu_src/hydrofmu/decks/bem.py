@@ -15,13 +15,21 @@ for several (Capytaine's joined bodies).  ω = ∞ is the infinite-frequency add
 the zero-frequency one (not used).
 
 WAMIT (manual, chapter 4): lines ``PER I J Ā [B̄]``, PER the period [s] (the default output,
-IPEROUT = 1), PER = −1 the infinite period (ω = 0) and PER = 0 the zero period (ω = ∞), both
-with Ā only.  Nondimensional with the length ULEN and the density ρ:
+IPEROUT = 1), PER = −1 the infinite period (ω = 0, kept as ``a_zero``) and PER = 0 the zero
+period (ω = ∞, ``a_inf``), both with Ā only.  The rows are read as WAMIT writes them:
+header lines first (``NUMHDR = 1``: ``WAMIT Numeric Output -- Filename …``; text that is not
+a row of numbers, before the first row), periods in any order (WAMIT writes them as the run's
+PER array, usually decreasing).  The first column may be another variable (WAMIT's IPEROUT),
+declared, never guessed (``PERIOD_VARIABLES``): ``omega`` [rad/s], ``wavenumber`` (KL =
+ω²L/g, needs g), ``hz``; the limit codes −1 and 0 are the period's, so with another
+variable a first column ≤ 0 is refused.  Nondimensional with the length ULEN and the density ρ:
 A = Ā·ρ·L^k, B = B̄·ρ·L^k·ω, k = 3 for I, J ≤ 3 (of each body), 5 for both rotations, 4 mixed.
 Several bodies: I = 6·(body − 1) + k, bodies named "body1", "body2", …  A pair (I, J) missing
 at every period is zero (WAMIT leaves out what it does not compute) and said in ``warnings``;
 a pair present at some periods and missing at others (a truncated or spliced file) is an
-error, and so is a pair of the finite periods missing from the PER = 0 (ω = ∞) rows.
+error, and so is a pair of the finite periods missing from the PER = 0 (ω = ∞) rows.  A row
+with more or fewer numbers than ``PER I J A [B]`` is an error at its line (decks/lines.py
+``numeric_rows``).
 
 Refused (InputError naming the file and the field): ``rho`` or ``g`` not a positive finite
 number, a ``water_depth`` not positive (inf is deep water), a negative or repeated frequency, two
@@ -35,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .lines import fortran_float
+from .lines import numeric_rows
 
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 
@@ -45,7 +53,7 @@ class BemData:
     """A BEM radiation result in SI units (see the module docstring).
 
     omega (N,) [rad/s] finite, > 0, increasing; added_mass, damping (N, n, n); a_inf (n, n) or
-    None; dofs [(body, k)] (k 1…6); bodies [names] in file order; rotation_centers
+    None; a_zero (n, n): the zero-frequency added mass when the file has it (kept, not used); dofs [(body, k)] (k 1…6); bodies [names] in file order; rotation_centers
     {body: [x, y, z]} [m] when the file gives them; rho [kg/m³], g [m/s²], water_depth [m]
     (inf: deep) or None when the file does not say; path: the file.
     """
@@ -56,6 +64,7 @@ class BemData:
     dofs: list
     bodies: list
     a_inf: np.ndarray = None
+    a_zero: np.ndarray = None
     rotation_centers: dict = field(default_factory=dict)
     rho: float = None
     g: float = None
@@ -71,20 +80,22 @@ class BemData:
             return None
 
 
-def read_bem(path, ulen=None, rho=None):
-    """Read a Capytaine dataset (.nc) or a WAMIT .1 file (by its extension)."""
+def read_bem(path, ulen=None, rho=None, g=None, period_variable=None):
+    """Read a Capytaine dataset (.nc) or a WAMIT .1 file (by its extension); ``ulen``,
+    ``rho``, ``g`` and ``period_variable`` (what the first column is) apply to WAMIT."""
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
-        if ulen is not None:   # an option that would change nothing is not taken silently
-            raise InputError(path, None, "ulen", "applies to a nondimensional WAMIT .1 file only: a Capytaine "
-                                                 "dataset is in SI units already")
+        for name, value, why in (("ulen", ulen, "a Capytaine dataset is in SI units already"),
+                                 ("period_variable", period_variable, "a Capytaine dataset's omega is in rad/s")):
+            if value is not None:   # an option that would change nothing is not taken silently
+                raise InputError(path, None, name, f"applies to a nondimensional WAMIT .1 file only: {why}")
         data = read_capytaine(path)
         if len(data.omega) < 3:   # the transform needs a grid (WAMIT: the same rule on its periods)
             raise InputError(path, None, "omega", f"{len(data.omega)} finite frequencies: at least 3 needed "
                                                   "(the ω = 0 and ω = ∞ rows do not count)")
         return data
     if path.suffix == ".1":
-        return read_wamit(path, ulen, rho)
+        return read_wamit(path, ulen, rho, g, period_variable)
     raise InputError(path, None, "bem", "expected a Capytaine NetCDF dataset (.nc) or a WAMIT .1 file")
 
 
@@ -214,7 +225,8 @@ def read_capytaine(path):
                  f"with the scene's (environment.rho, environment.g); check they match the BEM run"]
                 if missing else [])
     return BemData(str(path), w, a[fin][k], b[fin][k], dofs, bodies,
-                   a_inf=a[inf][0] if inf.any() else None, rotation_centers=centres,
+                   a_inf=a[inf][0] if inf.any() else None, a_zero=a[omega == 0][0] if (omega == 0).any() else None,
+                   rotation_centers=centres,
                    rho=scalars.get("rho"), g=scalars.get("g"), water_depth=scalars.get("water_depth"),
                    kind="Capytaine", warnings=warnings)
 
@@ -250,55 +262,89 @@ def _wamit_k(i, j):
     return 3 + ((i - 1) % 6 >= 3) + ((j - 1) % 6 >= 3)
 
 
-def read_wamit(path, ulen, rho):
-    """Read a WAMIT .1 file; ``ulen`` [m] and ``rho`` [kg/m³] make it dimensional."""
+# The first column of WAMIT's numeric outputs (the manual's IPEROUT, config file): what a
+# scene's ``period_variable`` (the CLI's --period-variable) declares it to be.
+PERIOD_VARIABLES = {
+    "period": "the wave period [s] (WAMIT's default, IPEROUT = 1)",
+    "omega": "the radian frequency ω [rad/s] (IPEROUT = 2)",
+    "wavenumber": "the nondimensional infinite-depth wavenumber KL = ω²·L/g (IPEROUT = 3)",
+    "hz": "the frequency f = ω/2π [Hz] (a converted file: not a WAMIT option)",
+}
+
+
+def period_variable(path, value):
+    """``value`` (None: the default "period") if it is one of PERIOD_VARIABLES, else an error."""
+    if value is None:
+        return "period"
+    if value not in PERIOD_VARIABLES:
+        raise InputError(path, None, "period_variable", f"expected one of {', '.join(map(repr, PERIOD_VARIABLES))}, "
+                                                        f"found {value!r} (WAMIT's IPEROUT = 4, the finite-depth "
+                                                        "wavenumber, is not read: write periods, IPEROUT = 1)")
+    return value
+
+
+def wamit_omega(path, number, value, variable, ulen=None, g=None):
+    """ω [rad/s] of a WAMIT row's first column ``value`` read as ``variable``; 0.0 and inf for
+    WAMIT's limit rows, PER = −1 (infinite period, ω = 0) and PER = 0 (zero period, ω = ∞).
+    Those codes are the period's: in another variable a value ≤ 0 is refused (a 0 there
+    could mean either limit; never guessed)."""
+    if variable == "period":
+        if value == -1.0:
+            return 0.0
+        if value == 0.0:
+            return np.inf
+        if value < 0:
+            raise InputError(path, number, "PER", f"period must be > 0, −1 (infinite) or 0 (zero), found {value:g}")
+        return 2 * np.pi / value
+    if value <= 0:
+        raise InputError(path, number, "PER", f"{value:g} where the first column is declared "
+                                              f"{PERIOD_VARIABLES[variable]} (period_variable = {variable!r}): "
+                                              "WAMIT marks the ω = 0 and ω = ∞ rows with the period codes −1 and 0, "
+                                              "which this variable cannot tell apart; write the file with periods "
+                                              "(IPEROUT = 1), or leave those rows out")
+    if variable == "omega":
+        return value
+    if variable == "hz":
+        return 2 * np.pi * value
+    return float(np.sqrt(value * g / ulen))     # wavenumber: KL = ω²L/g
+
+
+def read_wamit(path, ulen, rho, g=None, variable=None):
+    """Read a WAMIT .1 file; ``ulen`` [m] and ``rho`` [kg/m³] make it dimensional;
+    ``variable``: what its first column is (PERIOD_VARIABLES, default "period"); ``g``
+    [m/s²] converts a wavenumber."""
     path = Path(path)
     if ulen is None or not ulen > 0:
         raise InputError(path, None, "ulen", "a WAMIT .1 file is nondimensional: declare ULEN (ulen = … m), "
                                              "the length of the run's .gdf")
     if rho is None or not rho > 0:
         raise InputError(path, None, "rho", "declare the density that makes the WAMIT file dimensional")
-    try:
-        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
-    except OSError as exc:
-        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
-    rows = {}   # period → {(I, J): (A, B)}
+    variable = period_variable(path, variable)
+    if variable == "wavenumber" and (g is None or not g > 0):
+        raise InputError(path, None, "g", "a wavenumber column needs g (> 0) to give ω")
+    table, header = numeric_rows(path, ["PER", "I", "J", "A", "B"], (4, 5))
+    rows = {}   # ω (0: A(0), inf: A∞) → {(I, J): (A, B)}
     first = {}
-    for number, line in enumerate(text, 1):
-        words = line.replace(",", " ").split()
-        if not words:
-            continue
-        names = ["PER", "I", "J", "A", "B"]
-        if len(words) not in (4, 5):
-            raise InputError(path, number, "PER I J A B", f"expected 4 or 5 numbers, found {len(words)}: {line.strip()!r}")
-        vals = []
-        for name, w in zip(names, words):
-            try:
-                vals.append(fortran_float(w))
-            except ValueError:
-                raise InputError(path, number, name, f"not a number: {w!r}") from None
-            if not np.isfinite(vals[-1]):
-                raise InputError(path, number, name, f"non-finite value {w!r}")
-        per, i, j = vals[0], vals[1], vals[2]
-        for name, v in (("I", i), ("J", j)):
-            if v != int(v) or v < 1:
-                raise InputError(path, number, name, f"dof index must be a positive integer, found {v:g}")
-        i, j = int(i), int(j)
-        special = per in (-1.0, 0.0)
-        if per < 0 and not special:
-            raise InputError(path, number, "PER", f"period must be > 0, −1 (infinite) or 0 (zero), found {per:g}")
-        if not special and len(vals) != 5:
-            raise InputError(path, number, "B", f"missing the damping at period {per:g} s")
-        key = (per, i, j)
+    for number, vals in table:
+        w = wamit_omega(path, number, vals[0], variable, ulen, g)
+        i, j = (_dof_index(path, number, v, name) for v, name in ((vals[1], "I"), (vals[2], "J")))
+        if np.isfinite(w) and w > 0 and len(vals) != 5:
+            raise InputError(path, number, "B", f"missing the damping at {_as_written(vals[0], variable)}")
+        if not (np.isfinite(w) and w > 0) and len(vals) == 5 and vals[4] != 0:
+            raise InputError(path, number, "B", f"a damping {vals[4]:g} at PER = {vals[0]:g}: WAMIT writes Ā alone "
+                                                "at the limits (B = 0 there); a fifth number is a shifted row?")
+        key = (w, i, j)
         if key in first:
-            raise InputError(path, number, "I J", f"duplicate (PER, I, J) = ({per:g}, {i}, {j}) "
+            raise InputError(path, number, "I J", f"duplicate ({_as_written(vals[0], variable)}, I = {i}, J = {j}) "
                                                   f"(first at line {first[key]})")
         first[key] = number
-        rows.setdefault(per, {})[(i, j)] = (vals[3], vals[4] if len(vals) == 5 else 0.0)
-    periods = sorted((p for p in rows if p > 0), reverse=True)          # increasing ω
-    if len(periods) < 3:
-        raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 3 needed")
-    warnings = _wamit_pairs(path, rows, periods, first)
+        rows.setdefault(w, {})[(i, j)] = (vals[3], vals[4] if len(vals) == 5 else 0.0)
+    omegas = sorted(w for w in rows if np.isfinite(w) and w > 0)        # increasing ω
+    if len(omegas) < 3:
+        raise InputError(path, None, "PER", f"{len(omegas)} finite frequencies: at least 3 needed"
+                                            + ("" if table or not header else
+                                               f" (the file has {len(header)} text line(s) and no numeric row)"))
+    warnings = _wamit_pairs(path, rows, omegas, first)
     index = sorted({i for r in rows.values() for ij in r for i in ij})
     n = len(index)
     pos = {d: k for k, d in enumerate(index)}
@@ -309,30 +355,42 @@ def read_wamit(path, ulen, rho):
         for (i, j), v in r.items():
             m[pos[i], pos[j]] = v[col]
         return m * scale
-    omega = 2 * np.pi / np.array(periods)
-    a = np.array([matrices(rows[p], 0) for p in periods])
-    b = np.array([matrices(rows[p], 1) for p in periods]) * omega[:, None, None]
+    omega = np.array(omegas)
+    a = np.array([matrices(rows[w], 0) for w in omegas])
+    b = np.array([matrices(rows[w], 1) for w in omegas]) * omega[:, None, None]
     nb = (max(index) - 1) // 6 + 1
     bodies = [f"body{k + 1}" for k in range(nb)]
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in index]
     bodies = [x for x in bodies if any(d[0] == x for d in dofs)]
     return BemData(str(path), omega, a, b, dofs, bodies,
-                   a_inf=matrices(rows[0.0], 0) if 0.0 in rows else None,
+                   a_inf=matrices(rows[np.inf], 0) if np.inf in rows else None,
+                   a_zero=matrices(rows[0.0], 0) if 0.0 in rows else None,
                    rho=None, g=None, water_depth=None, kind="WAMIT", warnings=warnings)
 
 
-def _wamit_pairs(path, rows, periods, first):
-    """A pair (I, J) given at some finite periods (or at them but not at PER = 0) and missing
+def _as_written(value, variable):
+    return {"period": f"period {value:g} s", "omega": f"ω = {value:g} rad/s", "hz": f"f = {value:g} Hz",
+            "wavenumber": f"KL = {value:g}"}[variable]
+
+
+def _dof_index(path, number, value, name):
+    if value != int(value) or value < 1:
+        raise InputError(path, number, name, f"dof index must be a positive integer, found {value:g}")
+    return int(value)
+
+
+def _wamit_pairs(path, rows, omegas, first):
+    """A pair (I, J) given at some finite frequencies (or at them but not at PER = 0) and missing
     at others is an error (a truncated or spliced file, read as zeros otherwise); pairs of
-    given dofs missing at every period are zeros by WAMIT's rule, said as a warning."""
-    given = {ij for p in periods for ij in rows[p]}
-    for p in periods + ([0.0] if 0.0 in rows else []):
-        gap = sorted(given - set(rows[p]))
+    given dofs missing at every frequency are zeros by WAMIT's rule, said as a warning."""
+    given = {ij for w in omegas for ij in rows[w]}
+    for w in omegas + ([np.inf] if np.inf in rows else []):
+        gap = sorted(given - set(rows[w]))
         if gap:
             i, j = gap[0]
-            last = max(first[(p, *ij)] for ij in rows[p])
-            what = "the infinite-frequency rows (PER = 0)" if p == 0.0 else f"period {p:g} s"
-            raise InputError(path, last, "I J", f"{len(gap)} pair(s) given at other periods are missing at {what}, "
+            last = max(first[(w, *ij)] for ij in rows[w])
+            what = "the infinite-frequency rows (PER = 0)" if np.isinf(w) else f"ω = {w:.6g} rad/s"
+            raise InputError(path, last, "I J", f"{len(gap)} pair(s) given at other frequencies are missing at {what}, "
                              f"first ({i}, {j}) (its rows end at line {last}): a truncated file? every period "
                              "must list the same pairs")
     dofs = sorted({i for ij in given for i in ij})
@@ -341,4 +399,3 @@ def _wamit_pairs(path, rows, periods, first):
         return []
     shown = ", ".join(f"({i}, {j})" for i, j in absent[:6]) + (", …" if len(absent) > 6 else "")
     return [f"{path}: {len(absent)} pair(s) of its dofs missing at every period, read as zeros: {shown}"]
-

@@ -23,6 +23,16 @@ e^{+iωt}, phase relative to the incident elevation at the global origin: X = X�
 C = C̄·ρ·g·L^k, k = 2 + [I is a rotation] + [J is a rotation]; WAMIT's C(4,4), C(5,5),
 C(4,6), C(5,6) hold the weight terms (−m·g·z_G, m·g·x_G, …) of the run's mass
 properties (the .hst has no mass of its own to check against the scene).
+
+Read as WAMIT writes them (decks/lines.py ``numeric_rows``, decks/bem.py ``wamit_omega``):
+header lines first (``NUMHDR = 1``), then rows of exactly the layout's count of numbers (a row
+with more or fewer is an error at its line); the first column as declared (period by
+default; ``omega``, ``wavenumber``, ``hz``); the PER = −1 / 0 rows (no incident wave) are
+not excitation and are passed over.  Every period must list the same headings and every
+(period, heading) the same dofs (a gap is an error at its line: it would read as zeros);
+dofs of a body with no row at all (WAMIT leaves out modes it did not compute) read as zero
+and are said once (a warning naming them, kept in ``reading``).  A ``.hst`` pair given twice
+is an error; pairs of a body without a row read as zero and are said (WAMIT writes all 36).
 """
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,8 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .lines import fortran_float
-from .bem import DOF_NAMES, _single_name, check_scalar
+from .bem import DOF_NAMES, _single_name, check_scalar, period_variable, wamit_omega
+from .lines import Reading, numeric_rows
 
 
 @dataclass
@@ -52,6 +62,7 @@ class ExcitationData:
     rho: float = None
     g: float = None
     water_depth: float = None
+    reading: object = None    # decks.lines.Reading: the warnings of a WAMIT file
 
     def body(self, name):
         """(nω, nβ, 6) complex of one body, zero for dofs the file leaves out."""
@@ -78,6 +89,7 @@ class HydrostaticsData:
     rotation_centers: dict = field(default_factory=dict)
     rho: float = None
     g: float = None
+    reading: object = None    # decks.lines.Reading: the warnings of a WAMIT file
 
 
 def _open(path):
@@ -128,14 +140,16 @@ def _centres(ds, bodies):
     return {bodies[0]: rc.values.astype(float).tolist()}
 
 
-def read_excitation(path, ulen=None, rho=None, g=None) -> ExcitationData:
+def read_excitation(path, ulen=None, rho=None, g=None, period_variable=None) -> ExcitationData:
     """Excitation of a Capytaine dataset (.nc) or a WAMIT .3 / .2 file (``ulen`` [m], ``rho``,
-    ``g`` make WAMIT's values dimensional)."""
+    ``g`` make WAMIT's values dimensional; ``period_variable``: what its first column is,
+    decks/bem.py PERIOD_VARIABLES)."""
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        _not_capytaine(path, period_variable)
         return _capytaine_excitation(path)
     if path.suffix in (".2", ".3"):
-        return _wamit_excitation(path, ulen, rho, g)
+        return _wamit_excitation(path, ulen, rho, g, period_variable)
     raise InputError(path, None, "bem", "expected a Capytaine dataset (.nc) or a WAMIT .3 (diffraction) / "
                                         ".2 (Haskind) file for the wave excitation")
 
@@ -185,33 +199,6 @@ def _capytaine_excitation(path):
                           _scalar(ds, "rho", path), _scalar(ds, "g", path), _scalar(ds, "water_depth", path))
 
 
-def _numbers(path, names, minimum):
-    """[(line number, [floats])] of a WAMIT numeric file (one error naming line and field)."""
-    try:
-        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
-    except OSError as exc:
-        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
-    rows = []
-    for number, line in enumerate(text, 1):
-        words = line.replace(",", " ").split()
-        if not words:
-            continue
-        if len(words) < minimum:
-            raise InputError(path, number, " ".join(names), f"expected {len(names)} numbers, found {len(words)}: "
-                                                            f"{line.strip()!r}")
-        vals = []
-        for name, w in zip(names, words):
-            try:
-                v = fortran_float(w)
-            except ValueError:
-                raise InputError(path, number, name, f"not a number: {w!r}") from None
-            if not np.isfinite(v):
-                raise InputError(path, number, name, f"non-finite value {w!r}")
-            vals.append(v)
-        rows.append((number, vals))
-    return rows
-
-
 def _wamit_scale(path, ulen, rho, g):
     for name, v in (("ulen", ulen), ("rho", rho), ("g", g)):
         if v is None or not v > 0:
@@ -224,34 +211,71 @@ def _index(path, number, value, name="I"):
     return int(value)
 
 
-def _wamit_excitation(path, ulen, rho, g):
+def _wamit_excitation(path, ulen, rho, g, variable=None):
     _wamit_scale(path, ulen, rho, g)
-    rows = _numbers(path, ["PER", "BETA", "I", "MOD", "PHA", "RE", "IM"], 7)
+    variable = period_variable(path, variable)
+    rows, _ = numeric_rows(path, ["PER", "BETA", "I", "MOD", "PHA", "RE", "IM"])
     table, first = {}, {}
     for number, (per, beta, i, _, _, re, im) in rows:
-        if per in (0.0, -1.0):
+        w = wamit_omega(path, number, per, variable, ulen, g)
+        if not (np.isfinite(w) and w > 0):
             continue                      # the zero / infinite period limits: no excitation wave
-        if per < 0:
-            raise InputError(path, number, "PER", f"period must be > 0, found {per:g}")
         i = _index(path, number, i)
-        key = (per, beta, i)
+        key = (w, beta, i)
         if key in first:
             raise InputError(path, number, "PER BETA I", f"duplicate ({per:g}, {beta:g}, {i}) (first at line "
                                                          f"{first[key]})")
         first[key] = number
         table[key] = complex(re, im) * rho * g * ulen ** (2 if (i - 1) % 6 < 3 else 3)
-    periods = sorted({k[0] for k in table}, reverse=True)
+    omegas = sorted({k[0] for k in table})
     betas = sorted({k[1] for k in table})
     index = sorted({k[2] for k in table})
-    if len(periods) < 2:
-        raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 2 needed")
-    x = np.zeros((len(periods), len(betas), len(index)), complex)
-    for (per, beta, i), v in table.items():
-        x[periods.index(per), betas.index(beta), index.index(i)] = v
+    if len(omegas) < 2:
+        raise InputError(path, None, "PER", f"{len(omegas)} finite periods: at least 2 needed")
+    _excitation_gaps(path, table, first, omegas, betas, index)
+    x = np.zeros((len(omegas), len(betas), len(index)), complex)
+    for (w, beta, i), v in table.items():
+        x[omegas.index(w), betas.index(beta), index.index(i)] = v
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in index]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
-    return ExcitationData(str(path), "WAMIT", 2 * np.pi / np.array(periods), np.array(betas, float), x, dofs,
-                          bodies)
+    reading = Reading(str(path), "WAMIT " + path.suffix)
+    missing = {b: [k for k in range(1, 7) if (b, k) not in dofs] for b in bodies}
+    for b, ks in missing.items():
+        if ks:
+            reading.warn(None, "I", f"no rows for {', '.join(DOF_NAMES[k - 1] for k in ks)} of {b} (I = "
+                                    f"{', '.join(str(6 * (int(b[4:]) - 1) + k) for k in ks)}) at any period or "
+                                    "heading: read as zero excitation (WAMIT leaves out modes it did not compute; "
+                                    "a cut file drops them too)")
+    return ExcitationData(str(path), "WAMIT", np.array(omegas), np.array(betas, float), x, dofs, bodies,
+                          reading=reading)
+
+
+def _excitation_gaps(path, table, first, omegas, betas, index):
+    """Every (period, heading) must list the dofs of the file and every period the headings:
+    a gap (a truncated or spliced file) would read as zeros.  One error at the line where the
+    incomplete block ends."""
+    seen = {}
+    for (w, beta, i), number in first.items():
+        seen.setdefault((w, beta), {})[i] = number
+    for w in omegas:
+        for beta in betas:
+            block = seen.get((w, beta))
+            if block is None:
+                near = max(n for (ww, _), b in seen.items() if ww == w for n in b.values())
+                raise InputError(path, near, "BETA", f"heading {beta:g}° missing at ω = {w:.6g} rad/s (given at "
+                                                     "other periods): a truncated file? every period must list "
+                                                     "the same headings")
+            gap = [i for i in index if i not in block]
+            if gap:
+                raise InputError(path, max(block.values()), "I", f"dof(s) I = {', '.join(map(str, gap))} missing at "
+                                 f"ω = {w:.6g} rad/s, heading {beta:g}° (given at others): a truncated file? "
+                                 "every period and heading must list the same dofs")
+
+
+def _not_capytaine(path, variable):
+    if variable is not None:   # an option that would change nothing is not taken silently
+        raise InputError(path, None, "period_variable", "applies to a WAMIT file only: a Capytaine dataset's "
+                                                        "omega is in rad/s")
 
 
 def read_hydrostatics(path, ulen=None, rho=None, g=None) -> HydrostaticsData:
@@ -311,10 +335,13 @@ def _capytaine_hydrostatics(path):
 
 def _wamit_hydrostatics(path, ulen, rho, g):
     _wamit_scale(path, ulen, rho, g)
-    rows = _numbers(path, ["I", "J", "C"], 3)
-    stiffness = {}
+    rows, _ = numeric_rows(path, ["I", "J", "C"])
+    stiffness, first = {}, {}
     for number, (i, j, c) in rows:
         i, j = _index(path, number, i), _index(path, number, j, "J")
+        if (i, j) in first:
+            raise InputError(path, number, "I J", f"duplicate ({i}, {j}) (first at line {first[(i, j)]})")
+        first[(i, j)] = number
         bi, bj = (i - 1) // 6 + 1, (j - 1) // 6 + 1
         if bi != bj:
             if c != 0:
@@ -325,4 +352,12 @@ def _wamit_hydrostatics(path, ulen, rho, g):
         m[ki, kj] = c * rho * g * ulen ** (2 + (ki >= 3) + (kj >= 3))
     if not stiffness:
         raise InputError(path, None, "I J C", "no hydrostatic coefficients in the file")
-    return HydrostaticsData(str(path), "WAMIT", stiffness, sorted(stiffness), weight=True)
+    reading = Reading(str(path), "WAMIT .hst")
+    for b in sorted(stiffness):
+        base = 6 * (int(b[4:]) - 1)
+        absent = [(base + i, base + j) for i in range(1, 7) for j in range(1, 7) if (base + i, base + j) not in first]
+        if absent:
+            shown = ", ".join(f"({i}, {j})" for i, j in absent[:6]) + (", …" if len(absent) > 6 else "")
+            reading.warn(None, "I J", f"{len(absent)} of the 36 pairs of {b} have no row, read as zero: {shown} "
+                                      "(WAMIT writes every pair of a body; a cut file drops some)")
+    return HydrostaticsData(str(path), "WAMIT", stiffness, sorted(stiffness), weight=True, reading=reading)

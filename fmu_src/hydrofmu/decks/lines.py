@@ -339,8 +339,9 @@ def fields(line, names, kind=float, defaults=None, slash=None):
     empty = _empty_field(line.text)
     if empty is not None and empty < len(names):
         raise line.error(names[empty], f"empty field between commas; expected {' '.join(names)}")
-    if len(words) > len(names):
-        raise line.error(names[-1], f"expected {len(names)} values ({' '.join(names)}), found {len(words)}")
+    if len(words) > len(names):   # named at the physical line of the first value too many
+        raise line.at_word(len(names)).error(names[-1], f"expected {len(names)} values ({' '.join(names)}), "
+                                                        f"found {len(words)}")
     values = {}
     for i, (name, typ) in enumerate(zip(names, kinds)):
         if i >= len(words):
@@ -438,3 +439,54 @@ def check_profile(rows, where, reading=None):
         if reading is not None and odd:
             reading.warn(at(k, "direction"), where[k][1]["direction"], odd)
     return rows
+
+
+# --- numeric output files (WAMIT .1 .2 .3 .hst …) ------------------------------------------
+_STARTS_NUMBER = re.compile(r"[+-]?(\d|\.\d)")
+
+
+def _is_fortran_number(word):
+    try:
+        fortran_float(word)
+        return True
+    except ValueError:
+        return False
+
+
+def numeric_rows(path, names, counts=None):
+    """The rows of a file of numbers in columns (WAMIT's numeric outputs): ``(rows, header)``,
+    rows = [(line number, [floats])], header = [(line number, text)].
+
+    ``names``: the fields of a full row; ``counts``: the numbers of fields a row may have
+    (default: exactly ``len(names)``).  Lines before the first row whose first word does not
+    start like a number (and that are not all numbers: ``nan 1 1 …`` is a row) are header lines (WAMIT's ``NUMHDR=1`` line ``WAMIT Numeric Output --
+    Filename …``); after the first row every line must be a row.  A row with more fields than
+    its format, fewer, a word that is not a Fortran number or a non-finite value is one
+    InputError naming the file, the line and the field."""
+    counts = tuple(counts or (len(names),))
+    rows, header = [], []
+    for number, text in enumerate(read_text(path, "file").splitlines(), 1):
+        words = text.replace(",", " ").split()
+        if not words:
+            continue
+        if not rows and not _STARTS_NUMBER.match(words[0]) and not all(map(_is_fortran_number, words)):
+            header.append((number, text.strip()))
+            continue
+        values = []
+        for name, word in zip(names, words):
+            try:
+                value = fortran_float(word)
+            except ValueError:
+                where = "" if rows else " (a header line must not start like a number)"
+                raise InputError(path, number, name, f"not a number: {word!r}{where}") from None
+            if not math.isfinite(value):
+                raise InputError(path, number, name, f"non-finite value {word!r}")
+            values.append(value)
+        if len(words) not in counts:
+            many = len(words) > max(counts)
+            want = " or ".join(map(str, counts))
+            raise InputError(path, number, " ".join(names) if many else names[len(words)],
+                             f"expected {want} numbers ({' '.join(names)}), found {len(words)}: {text.strip()!r}"
+                             + (": more fields than the format (a merged or shifted line?)" if many else ""))
+        rows.append((number, values))
+    return rows, header

@@ -27,7 +27,10 @@ group without its IRX line; any other line left after one of our groups is an er
 level beyond NCULEV, a fourth CONB line).  A line that resembles one of our keywords
 (``UNIT NA SPEC``, ``NEW COMP BOD``, words after it) is an error, as is a second ``UNIT NAMe
 SPECification`` and a group right after a CONB whose first line reads as the CONB's IRX IRY
-IRZ line (a stray or misplaced line inside the CONB group).
+IRZ line (a stray or misplaced line inside the CONB group).  The codes are numbers (the
+manual's 0 and 1): a line of one to three freedom words after a CONB (``FIX FIX FREE``,
+``fixed``; ``CODE_WORDS``) is the IRX IRY IRZ line written in words, an error at its line and
+field, never a skipped group (it left the hinge a ball joint).
 """
 from dataclasses import dataclass, replace
 
@@ -183,12 +186,30 @@ def _read_group(cur, head, kind, seen):
 
     codes = (0, 0, 0)
     nxt = cur.peek()
+    if nxt is not None and _codes_in_words(nxt):
+        word = next(w for w in nxt.words if w.upper() in CODE_WORDS)
+        field_ = FREEDOM[nxt.words.index(word)]
+        raise nxt.at_word(nxt.words.index(word)).error(
+            field_, f"freedom codes are numbers, 0 (free) or 1 (fixed), found {word!r} in {nxt.text!r}: write "
+                    f"e.g. '1 1 0' (read as another data group, the line would leave the joint free)")
     if nxt is not None and not starts_group(nxt):
         codes = _codes(cur.next("IRX"))
     elif nxt is not None and not is_end(nxt) and cur.pos + 1 < len(cur.lines):
         after = cur.lines[cur.pos + 1]      # the group after the CONB: is its first line our IRX line?
         interrupted(nxt, f"CONB {name!r} (its IRX IRY IRZ line)", lambda: not starts_group(after) and _codes(after))
     return ConbData(**common, codes=codes)
+
+
+# words a CONB's IRX IRY IRZ line written in words would hold: no RIFLEX data group is named so
+CODE_WORDS = {"FIX", "FIXED", "FREE", "RIGID", "LOCK", "LOCKED", "PIN", "PINNED", "HINGE", "HINGED", "ON", "OFF",
+              "YES", "NO", "TRUE", "FALSE", "T", "F", "Y", "N", "ZERO", "ONE"}
+
+
+def _codes_in_words(line):
+    """True for a line of one to three words, all freedom words (``FIX FIX FREE``): the CONB's
+    IRX IRY IRZ line written in words, not a data group."""
+    words = [w.upper() for w in line.words]
+    return 1 <= len(words) <= 3 and all(w in CODE_WORDS for w in words)
 
 
 def _codes(line):

@@ -69,6 +69,16 @@ void hf_fail(Instance *inst, const char *fmt, ...) {
     inst->status = fmi2Error;
 }
 
+void hf_warn(Instance *inst, const char *fmt, ...) {
+    char text[1024];
+    int at = snprintf(text, sizeof text, "%s: ", inst->name ? inst->name : "");
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text + at, sizeof text - at, fmt, ap);
+    va_end(ap);
+    say(inst, fmi2Warning, "logStatusWarning", text);
+}
+
 void hf_set_error(Instance *inst, const char *fmt, ...) {
     if (inst->error[0]) return;   /* the first one counts */
     va_list ap;

@@ -67,6 +67,7 @@ void hf_fail(Instance *inst, const char *fmt, ...);   /* one error line for the 
 const Record *hf_record(const Instance *inst, const char *tag, int *from);   /* next record with the tag */
 int hf_check_finite(Instance *inst, const int *vrs, int n);   /* 1: all finite, else sets inst->error */
 void hf_set_error(Instance *inst, const char *fmt, ...);
+void hf_warn(Instance *inst, const char *fmt, ...);   /* one warning line for the host (status fmi2Warning) */
 
 extern const Model hf_load_model, hf_connector_model, hf_dynamics_model, hf_floor_model;
 

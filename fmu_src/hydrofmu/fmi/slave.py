@@ -67,11 +67,10 @@ from ..physics.joint import BallJoint
 from ..physics.loads import BodyLoads, make_effect
 from ..physics.lumped import LumpedBody
 from ..physics.memory import StateSpace
-from ..physics.rigid_body import CoupledBodies, RigidBody
+from ..physics.rigid_body import CAPSIZE, LINEAR_RANGE, CoupledBodies, GimbalLockError, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
-from ..physics.drift import phasors as drift_phasors
-from ..physics.waves import WaveLoad, components as wave_components
+from ..physics.waves import Phasors, WaveLoad, components as wave_components
 
 # the sea-state knobs each spectrum exposes as waves.* parameters: (unit, description)
 WAVE_KNOBS = {
@@ -487,6 +486,69 @@ class ArraySlave(Fmi2Slave):
     def set_physics_state(self, state):
         pass
 
+    # the scene's waves (load and connector FMUs): the waves.* parameters, one Phasors a step
+
+    def _add_waves(self, cfg):
+        """The sea-state parameters waves.* (start values: the scene's), the excitation's
+        outputs <name>.force, <name>.elevation (with an excitation) and each named point's
+        waves.<point>.velocity, acceleration, pressure, elevation; returns [the force slice] or []."""
+        self.wave, self.wave_cfg, self.phasors, self.water, self.kin = None, cfg, None, None, None
+        self.points = []
+        self.kin_wanted = cfg is not None and (cfg.kinematics or bool(cfg.points))
+        if cfg is None:
+            return []
+        Par, Out = Fmi2Causality.parameter, Fmi2Causality.output
+        self.wave_knobs = {k: self.add(f"waves.{k}", Par, WAVE_KNOBS[k][0], cfg.sea[k], WAVE_KNOBS[k][1])
+                           for k in SPECTRUM_KNOBS[cfg.spectrum]}
+        for name, where in cfg.points.items():
+            on_body = "offset" in where
+            what = f"at point {name} ({'on the body' if on_body else 'fixed'})"
+            first = self.add_vector(f"waves.{name}.velocity", 3, Out, "m/s", None,
+                                    f"incident-wave particle velocity {what}, global axes")
+            self.add_vector(f"waves.{name}.acceleration", 3, Out, "m/s2", None,
+                            f"incident-wave particle acceleration (local, du/dt) {what}, global axes")
+            self.add(f"waves.{name}.pressure", Out, "Pa", 0.0, f"incident-wave dynamic pressure {what}")
+            self.add(f"waves.{name}.elevation", Out, "m", 0.0, f"incident-wave elevation above point {name}")
+            block = slice(first.start, first.start + 8)
+            self.points.append((np.asarray(where.get("offset", where.get("position")), float), on_body, block))
+            self.depends([block], self.motion_inputs[:2] if on_body else [])
+        if cfg.name is None:
+            return []
+        force = self.add_vector(f"{cfg.name}.force", 6, Out, LIN_ROT["force"], None,
+                                "first-order wave excitation, global axes, about the reference point")
+        self.elevation = self.add(f"{cfg.name}.elevation", Out, "m", 0.0,
+                                  "wave elevation at the reference point's mean position")
+        self.depends([force, slice(self.elevation, self.elevation + 1)], [])
+        return [force]
+
+    def _start_waves(self):
+        """The phasors, excitation and kinematics of the sea state the waves.* parameters hold
+        now (one error naming the knob when they are not a usable sea state)."""
+        from ..physics.wave_kinematics import Water, WaveKinematics
+        cfg = self.wave_cfg
+        knobs = {k: float(self.values[vr]) for k, vr in self.wave_knobs.items()}
+        for k in ("components", "seed"):
+            if k in knobs and knobs[k] == int(knobs[k]):
+                knobs[k] = int(knobs[k])
+        sea = cfg.sea_state(**knobs)
+        g = float(self.values[self.g])
+        try:
+            sea.check()
+            comps = wave_components(sea, tuple(cfg.window) if cfg.window else (0.0, math.inf))
+            self.phasors = Phasors(comps, sea.ramp)
+            transfer = cfg.transfer(g, sea.depth)
+            self.wave = None if transfer is None else WaveLoad(comps, transfer, cfg.position, sea.ramp, g, sea.depth,
+                                                               phasors=self.phasors)
+            # the points and the effects each their own kernel: each keeps the factors of its last points
+            self.kin = WaveKinematics(comps, g, sea.depth, sea.stretching) if self.points else None
+            self.water = (Water(WaveKinematics(comps, g, sea.depth, sea.stretching), self.phasors,
+                                float(self.values[self.rho])) if cfg.kinematics else None)
+            drift = getattr(self, "drift_cfg", None)   # a load FMU's wave drift: the same components
+            self.drift = drift.kernel(comps, g, sea.depth) if drift is not None else None
+        except ValueError as exc:
+            self.phasors = self.wave = self.water = self.kin = self.drift = None
+            raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
+
 
 class LoadSlave(ArraySlave):
     """Loads on one floating body: motion in, force out (global axes, about the
@@ -523,7 +585,9 @@ class LoadSlave(ArraySlave):
                              for e in self.loads.effects]
         self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
-        wave_force = self._add_waves(cfg.waves) + self._add_drift(getattr(cfg, "drift", None))
+        wave_force = self._add_waves(cfg.waves)
+        self._wave_row = int(bool(wave_force))   # the output block's rows after the couplings: the excitation,
+        wave_force = wave_force + self._add_drift(getattr(cfg, "drift", None))   # then the drift
         # every load output in one block: total, each effect, each coupling, the waves
         self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
                                      + wave_force)]
@@ -542,25 +606,9 @@ class LoadSlave(ArraySlave):
         self.memories = []   # set up by start_physics
         self.stale = True
 
-    def _add_waves(self, cfg):
-        """The sea-state parameters waves.* (start values: the scene's) and the outputs
-        <name>.force, <name>.elevation; returns [the force slice] or [] without waves."""
-        self.wave, self.wave_cfg = None, cfg
-        if cfg is None:
-            return []
-        Par, Out = Fmi2Causality.parameter, Fmi2Causality.output
-        self.wave_knobs = {k: self.add(f"waves.{k}", Par, WAVE_KNOBS[k][0], cfg.sea[k], WAVE_KNOBS[k][1])
-                           for k in SPECTRUM_KNOBS[cfg.spectrum]}
-        force = self.add_vector(f"{cfg.name}.force", 6, Out, LIN_ROT["force"], None,
-                                "first-order wave excitation, global axes, about the reference point")
-        self.elevation = self.add(f"{cfg.name}.elevation", Out, "m", 0.0,
-                                  "wave elevation at the reference point's mean position")
-        self.depends([force, slice(self.elevation, self.elevation + 1)], [])
-        return [force]
-
     def _add_drift(self, cfg):
-        """The output <name>.force of the body's wave drift (on the waves' sea state); returns
-        [the force slice] or []."""
+        """The output <name>.force of the body's wave drift (on the waves' sea state and
+        phasors); returns [the force slice] or []."""
         self.drift, self.drift_cfg = None, cfg
         if cfg is None:
             return []
@@ -568,27 +616,6 @@ class LoadSlave(ArraySlave):
                                 f"second-order wave drift ({cfg.method}), global axes, about the reference point")
         self.depends([force], [])
         return [force]
-
-    def _start_waves(self):
-        """The wave kernel of the sea state the waves.* parameters hold now (one error naming
-        the knob when they are not a usable sea state)."""
-        cfg = self.wave_cfg
-        knobs = {k: float(self.values[vr]) for k, vr in self.wave_knobs.items()}
-        for k in ("components", "seed"):
-            if k in knobs and knobs[k] == int(knobs[k]):
-                knobs[k] = int(knobs[k])
-        sea = cfg.sea_state(**knobs)
-        g = float(self.values[self.g])
-        try:
-            sea.check()
-            comps = wave_components(sea, tuple(cfg.window))
-            wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
-            if self.drift_cfg is not None:   # the same components: one sea (both or neither)
-                self.drift = self.drift_cfg.kernel(comps, g, sea.depth)
-                self.sea_components, self.ramp_length = comps, sea.ramp
-            self.wave = wave
-        except ValueError as exc:
-            raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 
     def start_physics(self):
         """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
@@ -618,7 +645,7 @@ class LoadSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
-        if self.wave_cfg is not None and self.wave is None and self.running:
+        if self.wave_cfg is not None and self.phasors is None and self.running:
             try:   # (initialization failed on the sea state: no step goes on without its waves)
                 self._start_waves()
             except ValueError as exc:
@@ -626,21 +653,31 @@ class LoadSlave(ArraySlave):
                 return
         v = self.values
         ne = len(self.loads.effects)
-        nw = (self.wave_cfg is not None) + (self.drift_cfg is not None)
-        out = np.zeros((1 + ne + len(self.couplings) + nw, 6))   # total, effects, couplings, waves, drift
+        nd = self.drift_cfg is not None
+        out = np.zeros((1 + ne + len(self.couplings) + self._wave_row + nd, 6))   # total, effects, couplings, waves, drift
+        if self.phasors is not None:   # the FMU's one advance of the wave phasors this step
+            p = self.phasors.at(self.next_time or 0.0)
         if ne:
-            self.loads.effect_loads(self.motion(self.motion_inputs), self.env(), out[1:1 + ne])
+            env = self.env()
+            env.water = self.water
+            self.loads.effect_loads(self.motion(self.motion_inputs), env, out[1:1 + ne])
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
             out[k] -= mass.dot(v[acc])
-        if self.wave is not None:   # the last rows: functions of time only
-            t = self.next_time or 0.0
-            w = self.wave(t)
+        if self.wave is not None:   # a function of time only
+            w = self.wave(self.next_time or 0.0)
             out[1 + ne + len(self.couplings)] = w[:6]
             v[self.elevation] = w[6]
-            if self.drift is not None:
-                out[-1] = self.drift(drift_phasors(self.sea_components, t, self.ramp_length))
+        if self.drift is not None:   # the last row: quadratic in the ramped phasors r·p
+            r = self.phasors.ramp_factor
+            out[-1] = self.drift(p) * (r * r)
+        if self.points and self.kin is not None:
+            m = self.motion(self.motion_inputs) if any(b for _, b, _ in self.points) else None
+            where = [m.position + m.rot @ x if on_body else x for x, on_body, _ in self.points]
+            rows = self.kin.at(p, self.phasors.ramp_factor, where, float(v[self.rho]))
+            for (_, _, block), row in zip(self.points, rows):
+                v[block] = row
         out[0] = self._load_total.dot(out)   # (ndarray.dot: half the call cost of @ here)
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the
@@ -651,14 +688,17 @@ class LoadSlave(ArraySlave):
         # not stale: the inputs are those of the last evaluation, whose peek the step takes
         for mem, vel, _ in self.memories:
             mem.commit(self.values[vel], dt, peeked=not self.stale)
-        self.stale = bool(self.couplings) or self.wave is not None  # memory and wave outputs move with time
+        self.stale = bool(self.couplings) or self.phasors is not None  # memory and wave outputs move with time
 
     def physics_state(self):
-        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.wave is not None}
+        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
 
     def set_physics_state(self, state):
-        if state.get("waves") and self.wave is None:   # taken after initialization, restored before it
+        if state.get("waves") and self.phasors is None:   # taken after initialization, restored before it
             self._start_waves()
+        if state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
         saved = state["memory"]
         if len(saved) != len(self.memories):   # taken after initialization and restored before it, or back
             if saved:
@@ -720,6 +760,11 @@ class DynamicsSlave(ArraySlave):
         self.finish_registration()
         self.solver = None
         self.last_loads = None   # (summed loads, step) of the last step: the linear hold's slope
+        # roll and pitch of every body in the motion outputs (12 per body: position, attitude,
+        # velocity), the attitude variables they are, and the angle watched (LINEAR_RANGE until said)
+        self._tilt = np.array([12 * i + k for i in range(len(self.parts)) for k in (3, 4)])
+        self._tilt_vrs = [part["attitude"].start + k for part in self.parts for k in (0, 1)]
+        self._watch = LINEAR_RANGE
         self.stale = False
 
     def start_physics(self):
@@ -765,14 +810,35 @@ class DynamicsSlave(ArraySlave):
             last = self.last_loads
             rates = loads * 0.0 if last is None else (loads - last[0]) / last[1]
             self.last_loads = (loads, dt)
-        if self.solver is not None:   # the group's state is one vector already
-            acc = self.solver.step(dt, loads, rates).ravel()
-            out = np.concatenate((self.solver.y, acc))
-        else:
-            acc = self.bodies[0].step(dt, loads, rates)
-            out = np.concatenate((self.bodies[0]._y, acc))
+        try:
+            if self.solver is not None:   # the group's state is one vector already
+                acc = self.solver.step(dt, loads, rates).ravel()
+                out = np.concatenate((self.solver.y, acc))
+            else:
+                acc = self.bodies[0].step(dt, loads, rates)
+                out = np.concatenate((self.bodies[0]._y, acc))
+        except GimbalLockError as exc:   # the Euler angles' singularity: the body went over
+            self.error = f"capsized: {exc}"
+            return
         self.values[self._motion_vrs] = out
         self.checked = len(out) == len(self.output_vrs) and _finite(out.tolist())   # every output, then
+        tilt = out[self._tilt]
+        if max(tilt.max(), -tilt.min()) > self._watch:
+            self._watch_range(tilt, t + dt)
+
+    def _watch_range(self, tilt, t):
+        """Past the linear range: one warning per run; past CAPSIZE: the step fails, capsized."""
+        k = int(np.argmax(np.abs(tilt)))
+        var = self.vars[self._tilt_vrs[k]].name
+        angle = f"{var} ({'roll' if k % 2 == 0 else 'pitch'}) = {math.degrees(tilt[k]):.1f}° at t = {t:g} s"
+        if abs(tilt[k]) > CAPSIZE:
+            self.error = (f"capsized: {angle}: |roll| or |pitch| past {math.degrees(CAPSIZE):g}°, far outside "
+                          "the linear hydrostatics and first-order wave loads")
+            return
+        self.log(f"{self.instance_name}: left the linear range: {angle}, past {math.degrees(LINEAR_RANGE):g}°: "
+                 "the hydrostatics and first-order wave loads assume small angles (said once per run)",
+                 Fmi2Status.warning)
+        self._watch = CAPSIZE
 
     def physics_state(self):
         if not hasattr(self, "bodies"):
@@ -808,6 +874,8 @@ class ConnectorSlave(ArraySlave):
         self.side_b = (self.add_motion("B.", cfg.b, False, "side B")
                        if cfg.b is not None else None)
         inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
+        self.motion_inputs = self.side_a
+        self._add_waves(cfg.waves)   # the node feels the waves (no outputs of their own)
         self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,
                                        "load on side A, global axes, about A's reference point")
         self.force_b = self.add_vector("B.force", 6, Out, LIN_ROT["force"], None,
@@ -828,9 +896,19 @@ class ConnectorSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
+        if self.wave_cfg is not None and self.phasors is None and self.running:
+            try:   # (initialization failed on the sea state: no step goes on without its waves)
+                self._start_waves()
+            except ValueError as exc:
+                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
+                return
+        env = self.env()
+        if self.phasors is not None:
+            self.phasors.at(self.next_time or 0.0)
+            env.water = self.water
         a = self.motion(self.side_a)
         b = self.motion(self.side_b) if self.side_b else None
-        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, self.env())
+        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, env)
         if self.joint.uses_acceleration:
             if self.explicit:
                 load_a = load_a - self.joint.mass_matrix(a).dot(a.acceleration)
@@ -838,6 +916,24 @@ class ConnectorSlave(ArraySlave):
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
         v[self.gap], v[self.rotation] = gap, rotation
+
+    def start_physics(self):
+        if self.wave_cfg is not None:
+            self._start_waves()
+        self.stale = True
+
+    def step_physics(self, t, dt):
+        self.stale = self.phasors is not None   # the node's wave loads move with time
+
+    def physics_state(self):
+        return {"waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
+
+    def set_physics_state(self, state):
+        if state and state.get("waves") and self.phasors is None:
+            self._start_waves()
+        if state and state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
 
 
 class FeedthroughMemory:

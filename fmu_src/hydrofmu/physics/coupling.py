@@ -20,9 +20,11 @@ puts in its mass matrix (rows: the loaded body, columns: the driving body) in `e
 ``acceleration_load`` applies it as a force in `explicit` mode, where ``stability_indicator``
 tells whether the staggered exchange can converge.
 """
+import warnings
+
 import numpy as np
 
-from .memory import Convolution, StateSpace
+from .memory import Convolution, MemoryFitWarning, StateSpace
 
 
 class Coupling:
@@ -35,6 +37,9 @@ class Coupling:
     ``memory_length`` [s] may truncate the kernels) or 'state_space' (kernels realised to
     normalised RMS error ≤ tol, or at ``order``; see ``memory.realise``; ``fits``: stored
     {(IDOF_A, IDOF_B): Realisation} to use instead).  v0_a, v0_b: velocities at the start.
+    A state-space realisation that misses ``tol`` (or none usable, ``memory.realise``) is not
+    used: the coupling then steps the exact convolution (``method`` says which; ``fallback``
+    why, "" when none) and says so once in a ``MemoryFitWarning``.
     ``name``, ``bodies``: labels (the names ``target``/``source`` return).
 
     ``memory[side]``: the retardation evaluator of that side: ``advance(dt, v_source)`` moves
@@ -55,21 +60,29 @@ class Coupling:
         v0 = {"A": v0_a if own else v0_b, "B": v0_a}
         self.fits = {}
         self.memory = {}
+        self.fallback = ""
+        if method == "state_space":
+            stored = {(i - 1, j - 1): f for (i, j), f in (fits or {}).items()} or None
+            a = StateSpace(k_a, timdel, shape=(6, 6), v0=v0["A"], tol=tol, order=order,
+                           memory_length=memory_length, fits=stored)
+            if a.missed:   # a realisation that misses what was asked: the exact convolution instead
+                self.fallback = "; ".join(f"kernel ({i + 1}, {j + 1}): {why}" for (i, j), why in sorted(a.missed.items()))
+                warnings.warn(MemoryFitWarning(f"coupling {name or bodies}: state-space memory not used, "
+                                               f"convolution instead: {self.fallback}"), stacklevel=2)
+                method = "convolution"
+            else:
+                self.memory["A"] = a
+                self.fits = {(i + 1, j + 1): f for (i, j), f in a.fits.items()}
+                if "B" in self.sides:                  # the same realisations, transposed
+                    self.memory["B"] = StateSpace(kernels["B"], timdel, shape=(6, 6), v0=v0["B"],
+                                                  fits={(j, i): f for (i, j), f in a.fits.items()})
         if method == "convolution":
             for s in self.sides:
                 self.memory[s] = Convolution(kernels[s], timdel, shape=(6, 6), v0=v0[s],
                                              memory_length=memory_length)
-        elif method == "state_space":
-            stored = {(i - 1, j - 1): f for (i, j), f in (fits or {}).items()} or None
-            a = StateSpace(k_a, timdel, shape=(6, 6), v0=v0["A"], tol=tol, order=order,
-                           memory_length=memory_length, fits=stored)
-            self.memory["A"] = a
-            self.fits = {(i + 1, j + 1): f for (i, j), f in a.fits.items()}
-            if "B" in self.sides:                  # the same realisations, transposed
-                self.memory["B"] = StateSpace(kernels["B"], timdel, shape=(6, 6), v0=v0["B"],
-                                              fits={(j, i): f for (i, j), f in a.fits.items()})
-        else:
+        elif method != "state_space":
             raise ValueError(f"method must be 'convolution' or 'state_space', not {method!r}")
+        self.method = method
 
     @classmethod
     def from_deck(cls, data, *args, **kwargs):

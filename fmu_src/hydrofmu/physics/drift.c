@@ -1,19 +1,19 @@
 /* Second-order wave drift (physics/drift.py, the readable reference): a body's mean drift,
  * Newman's approximation or the full difference-frequency QTF on the components of the sea
- * that waves.c drew (hf_wave_build's parameters: one sea for every load).
+ * that waves.c drew (hf_wave_build's parameters: one sea for every load of the FMU).
  *
  * hf_drift_build runs once per initialization, after hf_wave_build: it reads each component's
- * frequency, direction and complex amplitude at the body, c_k = a_k e^{i phi_k} e^{-i k_k d_k}
- * (the elevation column of the wave table), interpolates the data at them as DriftLoad does,
- * and stacks the per-step coefficients.  hf_drift is the per-step kernel on the phasors at the
- * body, z_k = r(t) c_k e^{i w_k t}: the QTF referred to the origin times the origin's phasors
- * equals the QTF at the body's place (the "local" value drift.py interpolates) times these.
- *   mean:   F = sum_k |z_k|^2 Q_kk
- *   newman: F = |sum_k z_k sqrt(Q+_k)|^2 - |sum_k z_k sqrt(Q-_k)|^2
- *   qtf:    F = sum_i sum_{d=0..D} Re{w_d Q(i, i + d) z_i conj(z_{i+d})}, w_0 = 1, w_d = 2
- * Record (Drift.c_params): [method, cutoff (-1: none), nw, w (nw), data]; data: mean/newman
- * [nb, closed, directions (nb), values (nw nb 6)]; qtf [nh, closed, bidirectional, nu,
- * closed (unidirectional), uni (nu), headings (nh), x, y, re (nw nw nh nh 6), im (same)].
+ * frequency and direction, interpolates the data at them as DriftLoad does (the QTF on its
+ * value at the body's place, the phase e^{-i(k_i d_i - k_j d_j)} put back exactly), and stacks
+ * the per-step coefficients.  hf_drift is the per-step kernel on the FMU's shared phasors
+ * p_k = a_k e^{i(w_k t + phi_k)} (waves.c's HfPhasors, advanced once a step for every wave load)
+ * and the ramp r; the load is quadratic in the ramped phasors r p:
+ *   mean:   F = r^2 sum_k |p_k|^2 Q_kk = r^2 F_mean (a_k fixed: F_mean once)
+ *   newman: F = r^2 (|sum_k p_k s+_k|^2 - |sum_k p_k s-_k|^2), s = sqrt(Q+-) e^{-i k_k d_k}
+ *   qtf:    F = r^2 sum_i sum_{d=0..D} Re{w_d Q(i, i + d) p_i conj(p_{i+d})}, w_0 = 1, w_d = 2
+ * Record (Drift.c_params): [method, cutoff (-1: none), x, y, nw, w (nw), data]; data:
+ * mean/newman [nb, closed, directions (nb), values (nw nb 6)]; qtf [nh, closed, bidirectional,
+ * nu, closed (unidirectional), uni (nu), headings (nh), x, y, re (nw nw nh nh 6), im (same)].
  */
 #include <math.h>
 #include <stdarg.h>
@@ -170,26 +170,26 @@ static int mean_at(const double *p, double w, double beta, double *out, char *fi
 }
 
 int hf_drift_record_ok(const double *r, int n) {   /* the record's sizes agree with its length */
-    if (n < 4 || r[0] < 0 || r[0] > 2) return 0;
-    int nw = (int)r[2];
-    if (nw < 1 || n < 3 + nw + 5) return 0;
-    const double *d = r + 3 + nw;
+    if (n < 6 || r[0] < 0 || r[0] > 2) return 0;
+    int nw = (int)r[4];
+    if (nw < 1 || n < 5 + nw + 5) return 0;
+    const double *d = r + 5 + nw;
     if (r[0] < 2) {
         int nb = (int)d[0];
-        return nb >= 1 && n == 3 + nw + 2 + nb + 6 * nw * nb;
+        return nb >= 1 && n == 5 + nw + 2 + nb + 6 * nw * nb;
     }
     int nh = (int)d[0], nu = (int)d[3];
-    return nh >= 1 && nu >= 0 && nu <= nh && n == 3 + nw + 5 + nu + nh + 2 + 12 * nw * nw * nh * nh;
+    return nh >= 1 && nu >= 0 && nu <= nh && n == 5 + nw + 5 + nu + nh + 2 + 12 * nw * nw * nh * nh;
 }
 
-/* params: [method, n, ramp, D, omega (n), c (2n: the amplitudes at the body), coefficients, the
- * phasors' scratch (2n)] */
+/* params: [method, n, D, F_mean (6), coefficients]: mean none, newman s+ and s- (n 6 complex each),
+ * qtf the band (n (D + 1) 6 complex, the pair (j, i) folded in: 2 Q off the diagonal) */
 double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
                        char *m, size_t size) {
     (void)nrecord;
     int method = (int)record[0], n = (int)wave[0];
-    double cutoff = record[1];
-    const double *data = record + 2, *omega = wave + 2, *table = omega + n, *beta = table + 14 * n;
+    double cutoff = record[1], x = record[2], y = record[3];
+    const double *data = record + 4, *omega = wave + 2, *ampl = omega + n, *beta = ampl + 2 * n + 14 * n;
     Qtf Q = {0};
     int D = 0;
     if (method == 2) {
@@ -209,31 +209,43 @@ double *hf_drift_build(const double *wave, const double *record, int nrecord, do
             }
         }
     }
-    size_t ncoef = method == 0 ? 6 * (size_t)n : method == 1 ? 12 * (size_t)n : 12 * (size_t)n * (D + 1);
-    double *p = calloc(4 + 5 * (size_t)n + ncoef, sizeof(double));
+    size_t ncoef = method == 0 ? 0 : method == 1 ? 24 * (size_t)n : 12 * (size_t)n * (D + 1);
+    double *p = calloc(9 + ncoef, sizeof(double));
     if (!p) goto oom;
-    p[0] = method, p[1] = n, p[2] = wave[1], p[3] = D;
-    double *w = p + 4, *c = w + n, *coef = c + 2 * n;
-    for (int k = 0; k < n; k++) w[k] = omega[k], c[2 * k] = table[7 * k + 6], c[2 * k + 1] = -table[7 * (n + k) + 6];
+    p[0] = method, p[1] = n, p[2] = D;
+    double *mean = p + 3, *coef = p + 9;
     if (method < 2) {
         for (int k = 0; k < n; k++) {
-            double q[6];
+            double q[6], a2 = ampl[2 * k] * ampl[2 * k] + ampl[2 * k + 1] * ampl[2 * k + 1];
             if (mean_at(data, omega[k], beta[k], q, field, m, size)) goto bad;
+            double b = beta[k] * PI / 180.0, ph = -hf_wave_number(omega[k], g, depth) * (x * cos(b) + y * sin(b));
+            double c = cos(ph), s = sin(ph);
             for (int j = 0; j < 6; j++) {
-                if (method == 0) coef[6 * k + j] = q[j];
-                else coef[6 * k + j] = sqrt(q[j] > 0 ? q[j] : 0), coef[6 * (n + k) + j] = sqrt(q[j] < 0 ? -q[j] : 0);
+                mean[j] += a2 * q[j];
+                if (method == 1) {   /* s+- e^{-i k d}: (re, im) pairs, s+ then s- */
+                    double sp = sqrt(q[j] > 0 ? q[j] : 0), sm = sqrt(q[j] < 0 ? -q[j] : 0);
+                    coef[12 * k + 2 * j] = sp * c, coef[12 * k + 2 * j + 1] = sp * s;
+                    coef[12 * (n + k) + 2 * j] = sm * c, coef[12 * (n + k) + 2 * j + 1] = sm * s;
+                }
             }
         }
     } else {
-        for (int i = 0; i < n; i++)
+        for (int i = 0; i < n; i++) {
+            double bi = beta[i] * PI / 180.0, di = hf_wave_number(omega[i], g, depth) * (x * cos(bi) + y * sin(bi));
             for (int d = 0; d <= D && i + d < n; d++) {
                 int j = i + d;
                 if (cutoff >= 0 && omega[j] - omega[i] > cutoff * (1 + 1e-12)) continue;
-                double *q = coef + 12 * ((size_t)i * (D + 1) + d);
+                double *q = coef + 12 * ((size_t)i * (D + 1) + d), bj = beta[j] * PI / 180.0;
                 if (qtf_at(&Q, omega[i], omega[j], beta[i], beta[j], q, field, m, size)) goto bad;
-                if (d > 0)
-                    for (int k = 0; k < 12; k++) q[k] *= 2.0;   /* the pair (j, i) is the conjugate: 2 Re */
+                /* back to the origin: e^{-i(k_i d_i - k_j d_j)}; the pair (j, i) is the conjugate: 2 Re */
+                double ph = -(di - hf_wave_number(omega[j], g, depth) * (x * cos(bj) + y * sin(bj)));
+                double c = cos(ph) * (d > 0 ? 2.0 : 1.0), s = sin(ph) * (d > 0 ? 2.0 : 1.0);
+                for (int k = 0; k < 6; k++) {
+                    double re = q[2 * k], im = q[2 * k + 1];
+                    q[2 * k] = re * c - im * s, q[2 * k + 1] = re * s + im * c;
+                }
             }
+        }
     }
     free(Q.uni), free(Q.uni_d), free(Q.local);
     return p;
@@ -247,43 +259,36 @@ bad:
     return NULL;
 }
 
-void hf_drift(double *p, double t, double *out) {
-    int method = (int)p[0], n = (int)p[1], D = (int)p[3];
-    double length = p[2], r = 1.0;
-    const double *w = p + 4, *c = w + n, *coef = c + 2 * n;
-    size_t ncoef = method == 0 ? 6 * (size_t)n : method == 1 ? 12 * (size_t)n : 12 * (size_t)n * (D + 1);
-    double *z = p + 4 + 3 * (size_t)n + ncoef;
-    if (t < length) r = t <= 0.0 ? 0.0 : 0.5 * (1.0 - cos(PI * t / length));
-    memset(out, 0, sizeof(double) * 6);
-    if (method == 0) {
-        for (int k = 0; k < n; k++) {
-            double a2 = c[2 * k] * c[2 * k] + c[2 * k + 1] * c[2 * k + 1];
-            for (int j = 0; j < 6; j++) out[j] += a2 * coef[6 * k + j];
-        }
-        for (int j = 0; j < 6; j++) out[j] *= r * r;
+void hf_drift(const double *params, const double *z, double r, double *out) {
+    int method = (int)params[0], n = (int)params[1], D = (int)params[2];
+    const double *coef = params + 9;
+    double r2 = r * r;
+    if (method == 0) {   /* |p_k| = a_k: the mean is fixed, ramped */
+        for (int j = 0; j < 6; j++) out[j] = r2 * params[3 + j];
         return;
     }
-    for (int k = 0; k < n; k++) {   /* z_k = r c_k e^{i w_k t} */
-        double cs = cos(w[k] * t), sn = sin(w[k] * t);
-        z[2 * k] = r * (c[2 * k] * cs - c[2 * k + 1] * sn), z[2 * k + 1] = r * (c[2 * k] * sn + c[2 * k + 1] * cs);
-    }
+    memset(out, 0, sizeof(double) * 6);
     if (method == 1) {
         double pr[6] = {0}, pi[6] = {0}, mr[6] = {0}, mi[6] = {0};
-        for (int k = 0; k < n; k++)
+        for (int k = 0; k < n; k++) {
+            double zr = z[2 * k], zi = z[2 * k + 1];
+            const double *sp = coef + 12 * k, *sm = coef + 12 * (n + k);
             for (int j = 0; j < 6; j++) {
-                double sp = coef[6 * k + j], sm = coef[6 * (n + k) + j];
-                pr[j] += z[2 * k] * sp, pi[j] += z[2 * k + 1] * sp, mr[j] += z[2 * k] * sm, mi[j] += z[2 * k + 1] * sm;
-            }
-        for (int j = 0; j < 6; j++) out[j] = pr[j] * pr[j] + pi[j] * pi[j] - mr[j] * mr[j] - mi[j] * mi[j];
-    } else {
-        for (int i = 0; i < n; i++) {
-            double zr = z[2 * i], zi = z[2 * i + 1];
-            int last = i + D < n ? i + D : n - 1;
-            const double *q = coef + 12 * (size_t)i * (D + 1);
-            for (int j = i; j <= last; j++, q += 12) {   /* z_i conj(z_j) */
-                double xr = zr * z[2 * j] + zi * z[2 * j + 1], xi = zi * z[2 * j] - zr * z[2 * j + 1];
-                for (int k = 0; k < 6; k++) out[k] += xr * q[2 * k] - xi * q[2 * k + 1];
+                pr[j] += zr * sp[2 * j] - zi * sp[2 * j + 1], pi[j] += zr * sp[2 * j + 1] + zi * sp[2 * j];
+                mr[j] += zr * sm[2 * j] - zi * sm[2 * j + 1], mi[j] += zr * sm[2 * j + 1] + zi * sm[2 * j];
             }
         }
+        for (int j = 0; j < 6; j++) out[j] = r2 * (pr[j] * pr[j] + pi[j] * pi[j] - mr[j] * mr[j] - mi[j] * mi[j]);
+        return;
     }
+    for (int i = 0; i < n; i++) {
+        double zr = z[2 * i], zi = z[2 * i + 1];
+        int last = i + D < n ? i + D : n - 1;
+        const double *q = coef + 12 * (size_t)i * (D + 1);
+        for (int j = i; j <= last; j++, q += 12) {   /* p_i conj(p_j) */
+            double xr = zr * z[2 * j] + zi * z[2 * j + 1], xi = zi * z[2 * j] - zr * z[2 * j + 1];
+            for (int k = 0; k < 6; k++) out[k] += xr * q[2 * k] - xi * q[2 * k + 1];
+        }
+    }
+    for (int k = 0; k < 6; k++) out[k] *= r2;
 }

@@ -27,6 +27,11 @@ from dataclasses import dataclass
 import numpy as np
 
 
+class MemoryFitWarning(UserWarning):
+    """A state-space realisation not used as asked (physics.coupling.Coupling falls back to
+    the convolution): names the coupling, the kernel element and why."""
+
+
 def _elements(kernels, shape=None):
     """Normalise kernels to (shape, [(i, j, samples), …]), zero kernels left out.
 
@@ -265,11 +270,17 @@ class Realisation:
     pole pair σ ± iω; B is 1 on the first state of each block, so C holds the amplitudes
     (h = Σ c·e^{σt} + Σ e^{σt}·(c₁·cos ωt − c₂·sin ωt)).  All σ < 0.
     ``error``: normalised RMS fit error over the samples, √(mean (ĥ − h)²) / √(mean h²).
+    ``deviation``: ∫|ĥ − K| dt / ∫|K| dt with K the piecewise-linear kernel the convolution
+    uses, between the samples too (``realise``): the memory load of this realisation is
+    within deviation·∫|K| dt·max|v| of the convolution's, at any step (NaN: not judged, e.g.
+    a fit given by hand).  ``refused``: the orders ``realise`` refused and why ("" none).
     """
     A: np.ndarray
     B: np.ndarray
     C: np.ndarray
     error: float
+    deviation: float = float("nan")
+    refused: str = ""
 
     @property
     def order(self):
@@ -278,6 +289,14 @@ class Realisation:
     def __call__(self, t):
         """ĥ(t) for an array of times [s] ≥ 0."""
         return _basis(self.A, np.asarray(t, float)) @ self.C
+
+    def areas(self):
+        """Per mode, |γ|/|σ| [kernel unit·s]: the largest ∫|mode| dt, so ∫|ĥ| ≤ their sum."""
+        out, k = [], 0
+        for sig, om in _modes(self.A):
+            out.append((np.hypot(self.C[k], self.C[k + 1]) if om else abs(self.C[k])) / -sig)
+            k += 2 if om else 1
+        return np.array(out)
 
 
 def _modes(a):
@@ -316,6 +335,47 @@ def _assemble(poles):
     return a
 
 
+RESOLVED = 2.0     # largest |λ|·TIMDEL of a realised pole (λ = σ + iω_d): see realise
+CANCEL = 1e6       # largest Σ|γ_k|/|σ_k| of a realisation over ∫|K| dt: see realise
+BETWEEN = 8        # points per TIMDEL on which a fit is judged between the samples
+SLACK = 3.0        # between samples a fit may miss K by SLACK·(its miss at the samples + what they leave open)
+
+
+class _Judge:
+    """The piecewise-linear kernel K of samples h (``Convolution``'s: linear between them, zero
+    after the last) on the midpoint grid of BETWEEN points per TIMDEL over the fit's window
+    [0, 2T] (T = (N − 1)·TIMDEL), with ∫|K| dt (``area``) and what the samples leave open
+    between them (``open``, relative to the area): Δ/12·Σ|h_{k−1} − 2h_k + h_{k+1}| (a
+    parabola through three samples differs from their chords by that area) plus Δ/2·|h_{N−1}|
+    (the last step: the convolution's kernel jumps to zero there, a realisation decays)."""
+
+    def __init__(self, h, timdel):
+        n = h.size
+        self.step = timdel / BETWEEN
+        self.t = self.step * (np.arange(2 * (n - 1) * BETWEEN) + 0.5)
+        self.k = np.interp(self.t, timdel * np.arange(n), h, right=0.0)
+        self.area = self.step * np.abs(self.k).sum()
+        self.timdel, self.h = timdel, h
+        self.open = timdel * (np.abs(np.diff(h, 2)).sum() / 12.0 + 0.5 * abs(h[-1])) / self.area
+
+    def verdict(self, fit):
+        """(deviation ∫|ĥ − K|/∫|K|, "" or why the fit is refused)."""
+        areas = fit.areas()
+        cancel = areas.sum() / self.area
+        if not cancel <= CANCEL:   # (NaN too)
+            return np.inf, f"modes cancelling each other: Σ|c|/|σ| = {cancel:.3g}·∫|K| > {CANCEL:g}·∫|K|"
+        sig = np.array([s for s, _ in _modes(fit.A)])
+        tail = (areas * np.exp(sig * self.t[-1])).sum()   # ∫|ĥ| beyond the grid, at most
+        dev = (self.step * np.abs(fit(self.t) - self.k).sum() + tail) / self.area
+        n = self.h.size   # the same measure on the samples alone (both with the tail beyond the window)
+        at = self.timdel * np.abs(fit(self.timdel * np.arange(2 * n - 1)) - np.append(self.h, np.zeros(n - 1))).sum()
+        allowed = SLACK * ((at + tail) / self.area + self.open)
+        if not dev <= allowed:
+            return dev, (f"between the samples ∫|ĥ − K| = {dev:.3g}·∫|K|, more than {SLACK:g}× its miss at the "
+                         f"samples and what they leave open ({allowed:.3g}·∫|K|)")
+        return dev, ""
+
+
 def realise(h, timdel, tol=0.002, order=None, max_order=40):
     """Realise a sampled kernel h(k·TIMDEL), k = 0…N−1, as h(t) ≈ C·exp(A·t)·B.
 
@@ -326,16 +386,34 @@ def realise(h, timdel, tol=0.002, order=None, max_order=40):
     those samples, rows at a stride so they span half the window, shifted by one sample).
     Unstable poles are reflected into the left half plane (σ → −max(|σ|, 1/T), T the
     window) and poles on the negative real axis of the discrete plane (a pure sample-to-
-    sample alternation) are dropped, so every realisation is stable.  The amplitudes are
-    then fitted by least squares to all samples, the zero tail included.
+    sample alternation) are dropped, so every realisation is stable; so are poles the
+    sampling does not resolve, |λ|·TIMDEL > RESOLVED (= 2): linear interpolation between
+    samples misses a mode e^{λt} by up to (|λ|·TIMDEL)²/8 of its size, half of it at the
+    bound, and past it the samples say nothing of the mode's shape between them.  The
+    amplitudes are then fitted by least squares to all samples, the zero tail included.
+
+    A fit exact at the samples can still be far off between them (nearly equal fast poles
+    with huge amplitudes of opposite signs), and the state-space memory steps the realised
+    kernel, not the samples.  So each candidate is judged against the piecewise-linear
+    kernel K the convolution uses, on a grid of BETWEEN points per TIMDEL (``_Judge``), and
+    refused when its modes cancel each other beyond round-off's reach (Σ|γ_k|/|σ_k| >
+    CANCEL·∫|K| dt: each mode's area |γ|/|σ| bounds its share of the load) or when it misses
+    K between the samples by more than SLACK times its miss at the samples plus what the
+    samples leave open there.  ``deviation`` = ∫|ĥ − K| dt/∫|K| dt bounds the difference of
+    the two memory loads by deviation·∫|K| dt·max|v| whatever the step (both are exact for
+    a velocity linear within each step).
+
     ``order``: the ERA order to use (the realisation may come out smaller when modes are
-    dropped); else the smallest order whose error ‖ĥ − h‖/‖h‖ over the window (samples
-    and zero tail) is ≤ ``tol`` (or the best found up to ``max_order``).  Returns a
-    ``Realisation`` (check ``error`` against tol).
+    dropped; when refused, the next lower order that is not); else the smallest order whose
+    error ‖ĥ − h‖/‖h‖ over the window (samples and zero tail) is ≤ ``tol`` and that is not
+    refused (or the best not refused up to ``max_order``).  Returns a ``Realisation``
+    (check ``error`` against tol; ``refused`` says which orders were refused and why; order
+    0 with error 1: none could be used).
     """
     h = np.asarray(h, float).ravel()
     if h.size < 2 or not np.any(h):   # one sample spans no time: no memory, as in Convolution
-        return Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 0.0)
+        return Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 0.0, 0.0)
+    judge = _Judge(h, timdel)
     h = np.concatenate([h, np.zeros(h.size - 1)])
     t = timdel * np.arange(h.size)
     norm = np.linalg.norm(h)
@@ -347,8 +425,20 @@ def realise(h, timdel, tol=0.002, order=None, max_order=40):
     u, sv, vt = np.linalg.svd(h[i], full_matrices=False)
     shifted = u.T @ h[i + 1] @ vt.T
     rank = int(np.sum(sv > sv[0] * 1e-12))
-    orders = [min(order, rank)] if order is not None else range(1, min(max_order, rank) + 1)
-    best = Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0)
+    if order is not None:
+        orders = range(min(order, rank), 0, -1)     # the order asked, lower ones if refused
+    else:
+        orders = range(1, min(max_order, rank) + 1)
+    refused, candidates = [], []
+
+    def accept(fit, r):
+        dev, why = judge.verdict(fit)
+        if why:
+            refused.append(f"order {r}: {why}")
+            return None
+        fit.deviation, fit.refused = float(dev), "; ".join(refused)
+        return fit
+
     for r in orders:
         si = 1.0 / np.sqrt(sv[:r])
         mu = np.linalg.eigvals(si[:, None] * shifted[:r, :r] * si[None, :]).astype(complex)
@@ -356,13 +446,19 @@ def realise(h, timdel, tol=0.002, order=None, max_order=40):
         lam = np.log(mu[keep]) / timdel
         bad = lam.real >= 0                          # reflect into the left half plane
         lam[bad] = -np.maximum(lam[bad].real, 1.0 / t[-1]) + 1j * lam[bad].imag
-        if lam.size:
-            fit = _fit(lam, t, h, norm)
-            if fit.error < best.error:
-                best = fit
-        if best.error <= tol and order is None:
-            break
-    return best
+        lam = lam[np.abs(lam) * timdel <= RESOLVED]  # what the sampling resolves
+        if not lam.size:
+            continue
+        fit = _fit(lam, t, h, norm)
+        if order is not None or fit.error <= tol:
+            if (ok := accept(fit, r)) is not None:
+                return ok
+        else:
+            candidates.append((fit.error, r, fit))
+    for _, r, fit in sorted(candidates, key=lambda c: c[:2]):   # none met tol: the best not refused
+        if (ok := accept(fit, r)) is not None:
+            return ok
+    return Realisation(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0, 1.0, "; ".join(refused))
 
 
 def _fit(lam, t, h, norm):
@@ -416,19 +512,29 @@ class StateSpace:
     z_new = e^{μdt}·z + dt·φ₁(μdt)·v_old + dt·φ₂(μdt)·(v_new − v_old),
     φ₁(x) = (eˣ − 1)/x, φ₂(x) = (eˣ − 1 − x)/x².  Coefficients are cached per distinct dt
     (the last 16).
+
+    ``missed``: {(i, j): why} of the elements fitted here whose realisation misses ``tol``
+    (``order`` not given) or is empty (every order refused, see ``realise``): their memory
+    load is not the one asked for; ``physics.coupling.Coupling`` then uses ``Convolution``.
     """
 
     def __init__(self, kernels, timdel, shape=None, v0=None, tol=0.002, order=None,
                  max_order=40, memory_length=None, fits=None):
         self.shape, elems = _elements(kernels, shape)
         fits = dict(fits or {})
-        self.fits = {}
+        self.fits, self.missed = {}, {}
         mu, inp, out, gam = [], [], [], []
         for i, j, h in elems:
             if (i, j) not in fits:
                 if memory_length is not None:
                     h = h[: int(np.floor(memory_length / timdel + 1e-9)) + 1]
-                fits[(i, j)] = realise(h, timdel, tol, order, max_order)
+                f = fits[(i, j)] = realise(h, timdel, tol, order, max_order)
+                why = f" (refused: {f.refused})" if f.refused else ""
+                if f.order == 0 and f.error > 0.0:   # (error 0: a kernel with no memory)
+                    self.missed[(i, j)] = "no realisation could be used" + why
+                elif order is None and f.error > tol:
+                    self.missed[(i, j)] = (f"the best realisation misses the tolerance: normalised RMS error "
+                                           f"{f.error:.3g} > {tol:g} at order {f.order}{why}")
             f = self.fits[(i, j)] = fits[(i, j)]
             k = 0
             for sig, om in _modes(f.A):

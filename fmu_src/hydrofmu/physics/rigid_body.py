@@ -98,6 +98,11 @@ def _finite(x):
     return math.isfinite(sum(x.tolist()))
 
 GIMBAL_TOL = 1e-6  # |cos θ| below which the Euler-angle rates are declared singular
+# The range the load models assume (linear hydrostatics, first-order wave loads at the mean
+# position): the dynamics partner warns once when |roll| or |pitch| passes LINEAR_RANGE and
+# fails the step as capsized past CAPSIZE (or at the Euler angles' singularity) [rad].
+LINEAR_RANGE = math.radians(15.0)
+CAPSIZE = math.radians(90.0)
 
 # Butcher's 7-stage Runge–Kutta method of order 6: nodes c, weights b, coefficients a.
 RK_C = np.array([0.0, 1 / 3, 2 / 3, 1 / 3, 1 / 2, 1 / 2, 1.0])

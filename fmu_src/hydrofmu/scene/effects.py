@@ -14,7 +14,8 @@ def _aqwa_viscous_drag(problems, table, where):
         data, _ = from_deck(problems, table, where, read_viscous_drag, "body")
         if data is None:
             return None
-        return {"matrix": np.asarray(data.matrix).tolist(), "relative": data.option == "RELATIVE"}
+        return _drag_waves(problems, table, where, {"matrix": np.asarray(data.matrix).tolist(),
+                                                     "relative": data.option == "RELATIVE"})
     problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", False))
     matrix = problems.matrix(table, "matrix", f"{where}.matrix", 6)
     option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
@@ -22,7 +23,28 @@ def _aqwa_viscous_drag(problems, table, where):
         return None
     for k, message in admissible.negative_diagonal(matrix):
         problems.warn(f"{where}.matrix[{k + 1},{k + 1}]", message)
-    return {"matrix": matrix, "relative": option == "RELATIVE"}
+    return _drag_waves(problems, table, where, {"matrix": matrix, "relative": option == "RELATIVE"})
+
+
+def _flag(problems, table, key, where):
+    """A boolean key (default false), or None after recording the problem."""
+    value = table.get(key, False)
+    if not isinstance(value, bool):
+        problems.add(where, f"expected true or false, found {value!r}")
+        return None
+    return value
+
+
+def _drag_waves(problems, table, where, data):
+    """The drag's opt-in ``waves`` (our extension; RELATIVE only)."""
+    waves = _flag(problems, table, "waves", f"{where}.waves")
+    if waves is None:
+        return None
+    if waves and not data["relative"]:
+        problems.add(f"{where}.waves", "waves = true needs the RELATIVE option (the drag on the velocity relative "
+                                       "to the water); this drag is ABSOLUTE")
+        return None
+    return {**data, "waves": waves}
 
 
 def _deeplines_current_polar(problems, table, where):
@@ -59,8 +81,11 @@ def _deeplines_current_polar(problems, table, where):
             key = "symmetry" if "symmetry" in exc.message else "table"
             problems.add(f"{where}.{key}", f"{exc.field}: {exc.message}")
         return None
+    waves = _flag(problems, table, "waves", f"{where}.waves")
+    if waves is None:
+        return None
     return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
-            "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
+            "point": [data.xc, data.yc, data.zc], "surface": data.surfc, "waves": waves}
 
 
 LUMPED_KEYS = keys.names(keys.LUMPED)
@@ -111,14 +136,20 @@ def _riflex_body(problems, table, where):
 
 def _bem_entry(problems, table, where, reader):
     """(data read by ``reader``, file, BEM body name) of a BEM wave effect entry (keys bem,
-    body, ulen), or (None, None, None) after recording the problem."""
+    body, ulen, and period_variable when the effect takes it), or (None, None, None) after
+    recording the problem."""
+    from ..decks.bem import PERIOD_VARIABLES
     path = deck_path(problems, table, where, "bem")
     ulen = problems.number(table, "ulen", f"{where}.ulen", positive=True) if "ulen" in table else None
     body = problems.string(table, "body", f"{where}.body") if "body" in table else None
-    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None):
+    variable = (problems.choice(table, "period_variable", f"{where}.period_variable", tuple(PERIOD_VARIABLES))
+                if "period_variable" in table else None)
+    if path is None or ("ulen" in table and ulen is None) or ("body" in table and body is None) \
+            or ("period_variable" in table and variable is None):
         return None, None, None
     env = getattr(problems, "env", {})
-    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81))
+    extra = (variable,) if "period_variable" in table else ()
+    data = problems.deck(path, f"{where}.bem", reader, ulen, env.get("rho", 1025.0), env.get("g", 9.81), *extra)
     if data is None:
         return None, None, None
     if body is None:

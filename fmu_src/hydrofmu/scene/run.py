@@ -68,6 +68,64 @@ def _ecco(p, run, base, step):
     return out
 
 
+def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False, joints=None):
+    """The knobs a scene with waves or memory (or a BEM restoring as a load input) gets unless
+    the scene or its preset sets them: the linear load hold (the constant hold's half-step
+    lag takes ω·h/4 of critical damping from every mode whose restoring is a load input,
+    more than the 1–2 % radiation gives roll and pitch: physics.hold, docs/tuning.md) and a
+    step that keeps the linear hold's −(ω·h)³/6 within physics.hold.ZETA_BUDGET for the
+    fastest such mode (its dry frequency: an upper bound).  ``run_cfg["chosen"]`` lists what
+    was chosen and why."""
+    from ..physics.hold import natural_frequencies, stable_step
+    restoring = [(b, e) for b in bodies.values() for e in b.effects
+                 if e.type == "bem_hydrostatics" and e.data is not None]
+    waves = sea is not None or any(e.type == "wave_excitation" for b in bodies.values() for e in b.effects)
+    why = [w for w, has in (("waves", waves), ("radiation memory", bool(couplings)),
+                            ("BEM hydrostatics as a load input", bool(restoring))) if has]
+    run_cfg["chosen"] = []
+    # what a failed run's advice needs (cosim.master.advice): the waves' ramp and peak period
+    run_cfg["waves"] = None if sea is None else {
+        "ramp": sea.ramp, "period": sea.period if sea.spectrum == "regular" else sea.tp}
+    run_cfg["restoring_omega"] = None
+    if sea is not None and ramp_default:
+        run_cfg["chosen"].append(f"wave ramp {sea.ramp:g} s (3 peak periods)")
+    if not why:
+        return run_cfg
+    because = " and ".join(why)
+    free = run_cfg["preset"] is None and run_cfg["algorithm"] != "ecco"   # a preset's knobs are its own
+    # explicit acceleration loads and joints have their stability limits measured with the
+    # constant hold (docs/reliability.md): the linear hold extrapolates an inertia load that
+    # alternates from step to step, and joints' default springs are designed for the constant one
+    held = [w for w, has in (("explicit acceleration loads", any(b.accel_mode == "explicit" for b in bodies.values())),
+                             ("joints", bool(joints))) if has]
+    if free and "load_hold" not in run_cfg["set"] and held:
+        run_cfg["chosen"].append(f"constant load hold kept (the scene has {' and '.join(held)})")
+    elif free and "load_hold" not in run_cfg["set"]:
+        run_cfg["load_hold"] = "linear"
+        run_cfg["chosen"].append(f"linear load hold (the scene has {because})")
+    if restoring and run_cfg["stop"]:
+        import numpy as np
+        from ..physics.rigid_body import RigidBody
+        top = 0.0
+        for body, effect in restoring:
+            try:
+                m = RigidBody(body.mass, np.diag(body.inertia) if np.ndim(body.inertia) == 1 else body.inertia,
+                              body.cog).mass_matrix()
+                w = natural_frequencies(m, effect.data["stiffness"])
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+                continue
+            top = max([top, *w])
+        if top > 0:
+            run_cfg["restoring_omega"] = float(top)
+            step = stable_step(top, run_cfg["stop"], hold=run_cfg["load_hold"])
+            if free and "step" not in run_cfg["set"] and step != run_cfg["step"]:
+                run_cfg["chosen"].append(f"step {step:g} s (the fastest mode of the BEM restoring, "
+                                         f"{top:.3g} rad/s dry, keeps its load hold's damping change within "
+                                         f"0.1 % of critical)")
+                run_cfg["step"] = step
+    return run_cfg
+
+
 def read_run(p, run):
     """The run settings of ``[run]``: a preset's knobs under the ones the table sets, checked."""
     preset = run.get("preset")
