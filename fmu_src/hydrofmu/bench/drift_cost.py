@@ -74,9 +74,9 @@ def noisy(times, limit=0.25):
 
 
 def c_cost(counts=COUNTS, rounds=5, steps=2000):
-    """Rows per component count: µs per step of the compiled kernels (physics/waves.c's
-    hf_waves, physics/drift.c's hf_drift per method), timed in a C loop (bench/drift_timing.c),
-    median of interleaved rounds."""
+    """Rows per component count: µs per step of the compiled kernels, each with the shared
+    phasors' advance (physics/waves.c's hf_waves; physics/drift.c's hf_drift per method),
+    timed in a C loop (bench/drift_timing.c), median of interleaved rounds."""
     import ctypes
     from pathlib import Path
     from ..cc import cached_many
@@ -89,7 +89,8 @@ def c_cost(counts=COUNTS, rounds=5, steps=2000):
     lib.hf_wave_build.restype = ctypes.POINTER(ctypes.c_double)
     lib.hf_drift_build.restype = ctypes.POINTER(ctypes.c_double)
     lib.hf_bench_per_call.restype = ctypes.c_double
-    lib.hf_bench_per_call.argtypes = [ctypes.POINTER(ctypes.c_double), ctypes.c_int, ctypes.c_int, ctypes.c_double]
+    lib.hf_bench_per_call.argtypes = [ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double), ctypes.c_int,
+                                      ctypes.c_double]
 
     class Sea(ctypes.Structure):
         _fields_ = [("spectrum", ctypes.c_int)] + [(k, ctypes.c_double) for k in (
@@ -108,10 +109,12 @@ def c_cost(counts=COUNTS, rounds=5, steps=2000):
         params = {"waves": wave}
         for label, method, cut in (("mean", "mean", math.inf), ("newman", "newman", math.inf),
                                    ("qtf_cut", "qtf", 0.3), ("qtf", "qtf", math.inf)):
-            rec = Drift("drift", method, cut, data.omega, np.zeros(2), pairs=pairs, re=q.real, im=q.imag).c_params()
-            if method != "qtf":
+            if method == "qtf":
+                rec = Drift("drift", method, cut, data.omega, np.zeros(2), pairs=pairs, re=q.real, im=q.imag).c_params()
+            else:
                 mean = data.diagonal()
-                rec = [float(("mean", "newman").index(method)), -1.0] + mean.c_params()
+                rec = Drift("drift", method, cut, mean.omega, np.zeros(2), directions=mean.table.directions,
+                            values=mean.table.values.real).c_params()
             p = lib.hf_drift_build(wave, (ctypes.c_double * len(rec))(*rec), len(rec), ctypes.c_double(9.81),
                                    ctypes.c_double(math.inf), f, m, ctypes.c_size_t(400))
             assert p, m.value
@@ -120,7 +123,7 @@ def c_cost(counts=COUNTS, rounds=5, steps=2000):
         times = {k: [] for k in params}
         for _ in range(rounds):
             for k, p in params.items():
-                times[k].append(lib.hf_bench_per_call(p, 0 if k == "waves" else 1, calls, 0.05))
+                times[k].append(lib.hf_bench_per_call(wave, None if k == "waves" else p, calls, 0.05))
         per = {k: float(np.median(v)) for k, v in times.items()}
         row = {"components": n, **{f"c_{k}_us": 1e6 * v for k, v in per.items()}, "c_noisy": noisy(times)}
         row.update({f"c_{k}_x_waves": per[k] / per["waves"] for k in per if k != "waves"})
