@@ -69,7 +69,8 @@ def test_wamit_mean_drift_refuses_what_it_cannot_read(tmp_path):
     msg = refused("c.9", "".join(rows[:-1]), "I", len(rows) - 1)                    # yaw missing at one period
     assert "truncated" in msg
     refused("d.9", "".join(rows[:3] + mean_rows([8.0], [30.0], [1, 2, 6], f8)), "PER BETA1 BETA2", 3)
-    refused("e.9", "".join(rows) + "rows end here\n", "PER BETA1 BETA2 I MOD PHA RE IM", len(rows) + 1)
+    refused("e.9", "".join(rows) + "rows end here\n", "PER", len(rows) + 1)
+    refused("e.9", "".join(rows) + rows[0].rsplit(None, 1)[0] + "\n", "IM", len(rows) + 1)   # a field short
     refused("e.9", "".join(rows) + "a b c d e f g h\n", "PER", len(rows) + 1)       # text after the data
     with pytest.raises(InputError, match="ulen"):
         read_mean_drift(tmp_path / "c.9", None, RHO, G)

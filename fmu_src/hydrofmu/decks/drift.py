@@ -30,9 +30,10 @@ to the incident elevation at the origin, A the complex amplitude a·e^{iφ}):
   frequency grid written in neither is an error.  The diagonal (PER1 = PER2, BETA1 = BETA2)
   is the mean drift.
 
-Both: a first line that is not numbers is a header (WAMIT's NUMHDR = 1: "WAMIT Numeric
-Output -- Filename …"), anywhere else a line that is not numbers is an error at that line;
-a row with fewer or more fields than the layout is an error at the line; PER = 0 and −1
+Both (``lines.numeric_rows``, the first-order readers' rules): lines before the first row that
+do not start like a number are header lines (WAMIT's NUMHDR = 1: "WAMIT Numeric Output --
+Filename …"), after it every line must be a row; a row with fewer or more fields than the
+layout, a word that is not a number, a non-finite value are errors at the line; PER = 0 and −1
 (the zero and infinite periods) are skipped (no drift there); a repeated key is an error
 naming both lines; a dof given at some (periods, headings) and missing at others is an
 error (a truncated file); a dof missing at every one is zero (WAMIT leaves out what it does
@@ -56,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .lines import fortran_float
+from .lines import numeric_rows
 
 MEAN_SUFFIXES = (".7", ".8", ".9")
 QTF_SUFFIXES = (".10d", ".11d", ".12d")
@@ -169,45 +170,12 @@ def _scale_checked(path, ulen, rho, g):
             raise InputError(path, None, name, f"a WAMIT file is nondimensional: declare {name} (> 0)")
 
 
-def _is_number(word):
-    try:
-        fortran_float(word)
-        return True
-    except ValueError:
-        return False
-
-
 def _rows(path, names):
-    """[(line number, [floats])] of a WAMIT numeric file with exactly len(names) fields per
-    row; a first line that is not numbers is WAMIT's header (NUMHDR = 1)."""
-    try:
-        text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
-    except OSError as exc:
-        raise InputError(path, None, "file", f"cannot read ({exc.strerror})") from None
-    rows = []
-    layout = " ".join(names)
-    top = next((n for n, line in enumerate(text, 1) if line.split()), None)
-    for number, line in enumerate(text, 1):
-        words = line.replace(",", " ").split()
-        if not words:
-            continue
-        if number == top and not _is_number(words[0]):
-            continue                                   # WAMIT's header line (NUMHDR = 1)
-        if len(words) != len(names):
-            raise InputError(path, number, layout, f"expected {len(names)} fields, found {len(words)}: "
-                                                   f"{line.strip()!r}")
-        vals = []
-        for name, w in zip(names, words):
-            try:
-                v = fortran_float(w)
-            except ValueError:
-                raise InputError(path, number, name, f"not a number: {w!r}") from None
-            if not np.isfinite(v):
-                raise InputError(path, number, name, f"non-finite value {w!r}")
-            vals.append(v)
-        rows.append((number, vals))
+    """[(line number, [floats])] of a WAMIT numeric file with exactly len(names) fields per row
+    (lines.numeric_rows: WAMIT's header lines first, then only rows)."""
+    rows, _ = numeric_rows(path, names)
     if not rows:
-        raise InputError(path, None, layout, "no data rows")
+        raise InputError(path, None, " ".join(names), "no data rows")
     return rows
 
 
