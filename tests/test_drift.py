@@ -137,11 +137,23 @@ def test_wamit_12d_completes_the_triangle_by_conjugation(tmp_path, triangle):
     assert np.allclose(m.body("body1")[:, 0, :], q[idx, idx].real * scale, rtol=1e-6)
 
 
+def test_wamit_12d_first_columns_as_iperout_wrote_them(tmp_path):
+    """period_variable = "omega" (IPEROUT = 2): the same QTF from a file whose PER1, PER2
+    columns are ω [rad/s]."""
+    q = hermitian_qtf(PERIODS)
+    write_12d(tmp_path / "p.12d", PERIODS, q)
+    write_12d(tmp_path / "w.12d", [2 * math.pi / p for p in PERIODS], q)
+    a, b = read_qtf(tmp_path / "p.12d", ULEN, RHO, G), read_qtf(tmp_path / "w.12d", ULEN, RHO, G, "omega")
+    assert np.allclose(a.omega, b.omega, rtol=1e-6) and np.allclose(a.values, b.values)
+    with pytest.raises(InputError, match="period_variable"):
+        read_qtf(tmp_path / "w.12d", ULEN, RHO, G, "angular")
+
+
 def test_wamit_12d_refuses_holes_and_mirrors_that_disagree(tmp_path):
     q = hermitian_qtf(PERIODS)
     p = tmp_path / "hole.12d"
     write_12d(p, PERIODS, q, "lower", skip=(3, 1))
-    with pytest.raises(InputError, match="neither triangle.*PER1 = 10 s, PER2 = 7 s|neither triangle.*PER1 = 7 s"):
+    with pytest.raises(InputError, match="neither triangle.*PER1 = 10, PER2 = 7|neither triangle.*PER1 = 7, PER2 = 10"):
         read_qtf(p, ULEN, RHO, G)
     bad = q.copy()
     bad[1, 3] = -bad[1, 3]          # written in both triangles, one is not the other's conjugate

@@ -149,6 +149,7 @@ EFFECTS["wave_drift"] = {"deck": {}, "inline": {
     "method": (enum("mean", "newman", "qtf"), "mean drift, Newman's approximation (default) or the full "
                                               "difference-frequency QTF (WAMIT .10d/.11d/.12d)"),
     "cutoff": (POSITIVE, "qtf: the largest |ω_i − ω_j| kept [rad/s] (default: every pair)"),
+    "period_variable": PERIOD_VARIABLE,
 }}
 
 WAVES = {

@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .bem import period_variable as _variable, wamit_omega
 from .lines import numeric_rows
 
 MEAN_SUFFIXES = (".7", ".8", ".9")
@@ -138,28 +139,30 @@ class QTFData:
                              rho=self.rho, g=self.g, water_depth=self.water_depth, warnings=list(self.warnings))
 
 
-def read_mean_drift(path, ulen=None, rho=None, g=None) -> MeanDriftData:
-    """Mean drift of a WAMIT .7/.8/.9 file (``ulen`` [m], ``rho``, ``g`` make it dimensional),
+def read_mean_drift(path, ulen=None, rho=None, g=None, period_variable=None) -> MeanDriftData:
+    """Mean drift of a WAMIT .7/.8/.9 file (``ulen`` [m], ``rho``, ``g`` make it dimensional;
+    ``period_variable``: what its first column is, as the run's IPEROUT wrote it, default period),
     a WAMIT .10d/.11d/.12d (its diagonal) or a Capytaine dataset (.nc) holding
     ``drift_force_surge``, ``drift_force_sway``, ``drift_force_yaw`` (``hydrofmu meandrift``)."""
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
         return _capytaine_mean(path)
     if path.suffix in MEAN_SUFFIXES:
-        return _wamit_mean(path, ulen, rho, g)
+        return _wamit_mean(path, ulen, rho, g, _variable(path, period_variable))
     if path.suffix in QTF_SUFFIXES:
-        return read_qtf(path, ulen, rho, g).mean()
+        return read_qtf(path, ulen, rho, g, period_variable).mean()
     raise InputError(path, None, "bem", "expected a WAMIT mean drift file (.7 control surface, .8 momentum, "
                                         ".9 pressure), a WAMIT QTF (.10d/.11d/.12d) or a Capytaine dataset (.nc) "
                                         "with drift_force_surge/sway/yaw (hydrofmu meandrift)")
 
 
-def read_qtf(path, ulen=None, rho=None, g=None) -> QTFData:
-    """Difference-frequency QTF of a WAMIT .10d/.11d/.12d file."""
+def read_qtf(path, ulen=None, rho=None, g=None, period_variable=None) -> QTFData:
+    """Difference-frequency QTF of a WAMIT .10d/.11d/.12d file (its two first columns as the
+    run's IPEROUT wrote them: ``period_variable``, default period)."""
     path = Path(path)
     if path.suffix not in QTF_SUFFIXES:
         raise InputError(path, None, "bem", "expected a WAMIT difference-frequency QTF file (.10d, .11d or .12d)")
-    return _wamit_qtf(path, ulen, rho, g)
+    return _wamit_qtf(path, ulen, rho, g, _variable(path, period_variable))
 
 
 # ---------------------------------------------------------------------------- WAMIT
@@ -185,12 +188,13 @@ def _dof_index(path, number, value):
     return int(value)
 
 
-def _period(path, number, per, name="PER"):
-    """The period [s] of a row, None for the zero / infinite period limits."""
-    if per in (0.0, -1.0):
+def _period(path, number, per, omega_of, variable, ulen, g):
+    """The first column's value of a row (None for WAMIT's ω = 0 and ∞ limit rows: no drift
+    there), its ω [rad/s] kept in ``omega_of`` (bem.wamit_omega: period, omega, Hz or KL)."""
+    w = wamit_omega(path, number, per, variable, ulen, g)
+    if w == 0.0 or not np.isfinite(w):
         return None
-    if per < 0:
-        raise InputError(path, number, name, f"period must be > 0 (0 and −1: the limits), found {per:g}")
+    omega_of[per] = w
     return per
 
 
@@ -219,8 +223,8 @@ def _missing_dofs(path, table, keys, first):
 
 def _key_text(k):
     if len(k) == 3:
-        return f"PER = {k[0]:g} s, BETA1 = {k[1]:g}°, BETA2 = {k[2]:g}°"
-    return f"PER1 = {k[0]:g} s, PER2 = {k[1]:g} s, BETA1 = {k[2]:g}°, BETA2 = {k[3]:g}°"
+        return f"PER = {k[0]:g}, BETA1 = {k[1]:g}°, BETA2 = {k[2]:g}°"
+    return f"PER1 = {k[0]:g}, PER2 = {k[1]:g}, BETA1 = {k[2]:g}°, BETA2 = {k[3]:g}°"
 
 
 def _dof_warning(path, given, kind):
@@ -231,12 +235,12 @@ def _dof_warning(path, given, kind):
     return [f"{path}: dof(s) {absent} not in the file: read as zero (WAMIT leaves out what it does not compute)"]
 
 
-def _wamit_mean(path, ulen, rho, g):
+def _wamit_mean(path, ulen, rho, g, variable="period"):
     _scale_checked(path, ulen, rho, g)
     rows = _rows(path, ["PER", "BETA1", "BETA2", "I", "MOD", "PHA", "RE", "IM"])
-    table, first = {}, {}
+    table, first, omega_of = {}, {}, {}
     for number, (per, b1, b2, i, _, _, re, im) in rows:
-        per = _period(path, number, per)
+        per = _period(path, number, per, omega_of, variable, ulen, g)
         if per is None:
             continue
         i = _dof_index(path, number, i)
@@ -255,7 +259,7 @@ def _wamit_mean(path, ulen, rho, g):
         table.setdefault((per, b1, b2), {})[i] = complex(re, im)
     keys = sorted(table)
     given = _missing_dofs(path, table, keys, first)
-    periods = sorted({k[0] for k in keys}, reverse=True)          # increasing ω
+    periods = sorted({k[0] for k in keys}, key=omega_of.get)      # increasing ω
     uni = sorted({k[1] for k in keys if k[1] == k[2]})
     if len(periods) < 2:
         raise InputError(path, None, "PER", f"{len(periods)} finite periods: at least 2 needed")
@@ -265,7 +269,7 @@ def _wamit_mean(path, ulen, rho, g):
         for b in uni:
             if (per, b, b) not in table:
                 near = max((first[k + (i,)] for k in keys if k[0] == per for i in table[k]), default=None)
-                raise InputError(path, near, "PER BETA1 BETA2", f"no rows for PER = {per:g} s at BETA1 = BETA2 = "
+                raise InputError(path, near, "PER BETA1 BETA2", f"no rows for PER = {per:g} at BETA1 = BETA2 = "
                                                                 f"{b:g}° (given at other periods): every period must "
                                                                 f"list the same headings")
     values = np.array([[[_dim(table[(p, b, b)][i].real, i, rho, g, ulen) for i in given] for b in uni]
@@ -279,19 +283,21 @@ def _wamit_mean(path, ulen, rho, g):
         if np.isnan(v.real).any():
             p = periods[int(np.argwhere(np.isnan(v.real).any(axis=1))[0][0])]
             raise InputError(path, None, "PER BETA1 BETA2", f"bidirectional pair ({b1:g}°, {b2:g}°) missing at "
-                                                            f"PER = {p:g} s (given at other periods)")
+                                                            f"PER = {p:g} (given at other periods)")
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
-    return MeanDriftData(str(path), f"WAMIT {path.suffix}", 2 * np.pi / np.array(periods), np.array(uni, float),
+    return MeanDriftData(str(path), f"WAMIT {path.suffix}", np.array([omega_of[p] for p in periods]),
+                         np.array(uni, float),
                          values, dofs, bodies, cross=cross, warnings=_dof_warning(path, given, path.suffix))
 
 
-def _wamit_qtf(path, ulen, rho, g):
+def _wamit_qtf(path, ulen, rho, g, variable="period"):
     _scale_checked(path, ulen, rho, g)
     rows = _rows(path, ["PER1", "PER2", "BETA1", "BETA2", "I", "MOD", "PHA", "RE", "IM"])
-    table, first = {}, {}
+    table, first, omega_of = {}, {}, {}
     for number, (p1, p2, b1, b2, i, _, _, re, im) in rows:
-        p1, p2 = _period(path, number, p1, "PER1"), _period(path, number, p2, "PER2")
+        p1 = _period(path, number, p1, omega_of, variable, ulen, g)
+        p2 = _period(path, number, p2, omega_of, variable, ulen, g)
         if p1 is None or p2 is None:
             continue
         i = _dof_index(path, number, i)
@@ -304,7 +310,7 @@ def _wamit_qtf(path, ulen, rho, g):
         table.setdefault((p1, p2, b1, b2), {})[i] = _dim(complex(re, im), i, rho, g, ulen)
     keys = sorted(table)
     given = _missing_dofs(path, table, keys, first)
-    periods = sorted({k[0] for k in keys} | {k[1] for k in keys}, reverse=True)    # increasing ω
+    periods = sorted({k[0] for k in keys} | {k[1] for k in keys}, key=omega_of.get)    # increasing ω
     if len(periods) < 2:
         raise InputError(path, None, "PER1 PER2", f"{len(periods)} finite periods: at least 2 needed")
     pairs = sorted({(k[2], k[3]) for k in keys} | {(k[3], k[2]) for k in keys})
@@ -331,7 +337,7 @@ def _wamit_qtf(path, ulen, rho, g):
         a, b, c = holes[0]
         raise InputError(path, None, "PER1 PER2 BETA1 BETA2",
                          f"{len(holes)} (PER1, PER2, headings) combination(s) written in neither triangle, first "
-                         f"PER1 = {periods[a]:g} s, PER2 = {periods[b]:g} s, headings {pairs[c]} (the file's periods "
+                         f"PER1 = {periods[a]:g}, PER2 = {periods[b]:g}, headings {pairs[c]} (the file's periods "
                          f"make a {n} × {n} grid; every pair must be in one triangle)")
     idx = np.arange(n)
     for c, (b1, b2) in enumerate(pairs):
@@ -340,13 +346,13 @@ def _wamit_qtf(path, ulen, rho, g):
             bad = np.abs(d.imag) > REAL_RTOL * np.abs(d) + 1e-12
             if bad.any():
                 k, m = np.argwhere(bad)[0]
-                raise InputError(path, line[k, k, c], "IM", f"the diagonal (PER1 = PER2 = {periods[k]:g} s, "
+                raise InputError(path, line[k, k, c], "IM", f"the diagonal (PER1 = PER2 = {periods[k]:g}, "
                                                             f"BETA1 = BETA2 = {b1:g}°) is the mean drift, real; "
                                                             f"found Im = {d[k, m].imag:g}")
             q[idx, idx, c] = d.real
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
-    return QTFData(str(path), f"WAMIT {path.suffix}", 2 * np.pi / np.array(periods), pairs, q, dofs, bodies,
+    return QTFData(str(path), f"WAMIT {path.suffix}", np.array([omega_of[p] for p in periods]), pairs, q, dofs, bodies,
                    warnings=_dof_warning(path, given, path.suffix))
 
 
