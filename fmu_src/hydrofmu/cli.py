@@ -496,16 +496,10 @@ def main(argv=None):
     """The command line; returns the exit code: 0 done, 1 a run or validation failed,
     2 bad input (one ``error:`` line naming the file, line or key path and field),
     3 an internal error (one line; HYDROFMU_DEBUG=1 shows the traceback)."""
-    _SAID.clear()
+    _SAID.clear()   # each warning once per command: `tune` and `batch` read the scene again per case
     with warnings.catch_warnings():
         warnings.simplefilter("always", InputWarning)
-        said = set()   # each warning once per command: `tune` and `batch` read the scene again per case
-
-        def show(message, category, filename, lineno, file=None, line=None):
-            if str(message) not in said:
-                said.add(str(message))
-                _show_warning(message, category, filename, lineno, file, line)
-        warnings.showwarning = show
+        warnings.showwarning = _show_warning
         try:
             return _main(argv)
         except InputError as exc:
