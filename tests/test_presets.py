@@ -2,6 +2,7 @@
 the knobs it sets itself win; a run reports the preset and every knob; and the presets
 order as promised against the monolithic two-body solution."""
 import json
+from pathlib import Path
 
 import pytest
 
@@ -11,6 +12,7 @@ from hydrofmu.errors import InputError
 from hydrofmu.fmi.build import build_scene
 from hydrofmu.scene import PRESETS, load_scene
 
+ROOT = Path(__file__).resolve().parents[1]
 MOVING = [0, 1, 2, 7, 8]   # body 1 surge, sway, heave; body 2 sway, heave
 
 
@@ -49,9 +51,17 @@ def test_scene_knobs_win_and_are_reported(tmp_path):
 
 
 def test_no_preset_keeps_the_defaults(tmp_path):
+    """Without a preset: the defaults, but the linear load hold where the scene has memory (the
+    constant hold's half-step lag against light damping, docs/tuning.md); a scene without
+    memory, waves or BEM hydrostatics keeps the constant hold."""
     scene = load_scene(fleet_scene(tmp_path, "stop = 1.0"))
-    assert scene.run["preset"] is None and scene.run["step"] == 0.1 and scene.run["load_hold"] == "constant"
+    assert scene.run["preset"] is None and scene.run["step"] == 0.1 and scene.run["load_hold"] == "linear"
+    assert scene.run["chosen"] == ["linear load hold (the scene has radiation memory)"]
     assert all(c.method == "convolution" for c in scene.couplings)
+    scene = load_scene(fleet_scene(tmp_path, 'stop = 1.0\nload_hold = "constant"'))
+    assert scene.run["load_hold"] == "constant" and scene.run["chosen"] == []   # the scene's own word wins
+    plain = load_scene(ROOT / "models" / "moored_barge.toml")
+    assert plain.run["load_hold"] == "constant" and plain.run["chosen"] == []
 
 
 def test_unknown_preset_is_named(tmp_path):

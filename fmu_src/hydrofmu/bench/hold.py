@@ -6,8 +6,8 @@ of models/ and the wave test scenes stay bounded with each hold and step.
    load FMU, initial pitch rate 0.03 rad/s), with and without the radiation memory (its
    coupling): the growth rate σ of the peaks (log-linear fit) at each hold and step, as a
    damping ratio ζ = −σ/ω, against ζ_rad (the linear hold at 0.01 s with memory) + Δζ.
-2. Every scene of models/ and the cylinder in a JONSWAP sea (Hs 2 m, Tp 9 s, the scene the
-   docs start from) with each hold at its step and twice it: bounded (largest |attitude| under
+2. Every scene of models/ and the cylinder in a JONSWAP sea (Hs 2 m, Tp 9 s, 30°, no ramp)
+   with each hold at its step and twice it: bounded (largest |attitude| under
    90°, finite) and the largest roll/pitch, over ``stop`` seconds.
 """
 from __future__ import annotations
@@ -95,7 +95,7 @@ def decay(out, steps=(0.05, 0.1, 0.2), stop=30.0):
     return rows
 
 
-SEA = '[waves]\nspectrum = "jonswap"\nhs = 2.0\ntp = 9.0\ndirection = 30.0\n'
+SEA = '[waves]\nspectrum = "jonswap"\nhs = 2.0\ntp = 9.0\ndirection = 30.0\nramp = 0.0\n'   # no ramp: the hold alone
 
 
 def scenes(out, stop=300.0, factors=(1, 2)):

@@ -18,6 +18,7 @@ MOTION = {"position": (("x", "y", "z"), ("m",) * 3),
           "attitude": (("roll", "pitch", "yaw"), ("rad",) * 3)}
 LOAD = (("Fx", "Fy", "Fz", "Mx", "My", "Mz"), ("N",) * 3 + ("N.m",) * 3)
 STATS = ("mean", "std", "min", "max")
+_FLAVOURS = {"python": "Python", "c": "compiled"}
 
 
 @dataclass
@@ -31,6 +32,7 @@ class Summary:
     points: int
     rows: list
     notes: list = field(default_factory=list)
+    flavour: str = None   # the FMUs that ran: 'python' or 'c' (None: not recorded)
 
     def to_dict(self) -> dict:
         """Nested: ``bodies[body][quantity][dof] = {unit, mean, std, min, max}``."""
@@ -38,7 +40,8 @@ class Summary:
         for r in self.rows:
             bodies.setdefault(r["body"], {}).setdefault(r["quantity"], {})[r["dof"]] = {
                 k: r[k] for k in ("unit",) + STATS}
-        return {"scene": self.scene, "from": self.start, "to": self.stop, "points": self.points,
+        return {"scene": self.scene, "flavour": _FLAVOURS.get(self.flavour), "from": self.start, "to": self.stop,
+                "points": self.points,
                 "statistics": "over the recorded points with from <= t <= to; std = population (1/n)",
                 "notes": self.notes, "bodies": bodies}
 
@@ -55,7 +58,9 @@ class Summary:
     def __str__(self):
         """The table: one line per body, quantity and dof that is not zero throughout (those
         are named in one line per body below the table)."""
-        head = (f"summary of {self.scene or 'the run'}, t = {self.start:g}–{self.stop:g} s ({self.points} points; "
+        kind = _FLAVOURS.get(self.flavour)
+        head = (f"summary of {self.scene or 'the run'}" + (f" ({kind} flavour)" if kind else "")
+                + f", t = {self.start:g}–{self.stop:g} s ({self.points} points; "
                 f"global axes, moments about each body's reference point, attitude in rad)")
         cells = [("body", "quantity", "dof", "unit") + STATS]
         zero = {}
@@ -83,6 +88,24 @@ def _row(body, quantity, dof, unit, x):
     return {"body": body, "quantity": quantity, "dof": dof, "unit": unit, **dict(zip(STATS, stats))}
 
 
+def linear_range(result, manifest) -> list[str]:
+    """One line: the largest |roll| and |pitch| of every body over the whole run [deg], and
+    whether they stayed within the range the loads assume (rigid_body.LINEAR_RANGE)."""
+    from ..physics.rigid_body import LINEAR_RANGE
+    worst = []
+    for body in sorted(manifest["dynamics"]):
+        att = np.abs(result.motion(body, "attitude", 2))
+        if att.size:
+            worst.append((body, float(np.degrees(np.nanmax(att[:, 0]))), float(np.degrees(np.nanmax(att[:, 1])))))
+    if not worst:
+        return []
+    limit = math.degrees(LINEAR_RANGE)
+    out = [f"{b} |roll| ≤ {r:.3g}°, |pitch| ≤ {p:.3g}°" for b, r, p in worst]
+    past = [b for b, r, p in worst if max(r, p) > limit]
+    return [f"linear range ({limit:g}° roll/pitch, docs/running.md): " + "; ".join(out)
+            + (f": {', '.join(past)} left it (linear_range = false)" if past else ": within it")]
+
+
 def summarize(result, transient=0.0) -> Summary:
     """The `Summary` of a Result over t ≥ ``transient`` [s]."""
     from .report import body_loads
@@ -99,6 +122,7 @@ def summarize(result, transient=0.0) -> Summary:
             rows += [_row(body, quantity, d, u, values[:, i]) for i, (d, u) in enumerate(zip(dofs, units))]
         for effect, load in body_loads(result, manifest, body).items():
             rows += [_row(body, effect, d, u, load[keep, i]) for i, (d, u) in enumerate(zip(*LOAD))]
+    notes = list(notes) + linear_range(result, manifest)
     t = result.time[keep]
     return Summary(manifest.get("scene", ""), float(t[0]) if t.size else 0.0, float(t[-1]) if t.size else 0.0,
-                   int(t.size), rows, notes)
+                   int(t.size), rows, notes, manifest.get("flavour"))

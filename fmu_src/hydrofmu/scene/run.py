@@ -68,7 +68,7 @@ def _ecco(p, run, base, step):
     return out
 
 
-def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False):
+def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False, joints=None):
     """The knobs a scene with waves or memory (or a BEM restoring as a load input) gets unless
     the scene or its preset sets them: the linear load hold (the constant hold's half-step
     lag takes ω·h/4 of critical damping from every mode whose restoring is a load input,
@@ -93,7 +93,14 @@ def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False):
         return run_cfg
     because = " and ".join(why)
     free = run_cfg["preset"] is None and run_cfg["algorithm"] != "ecco"   # a preset's knobs are its own
-    if free and "load_hold" not in run_cfg["set"]:
+    # explicit acceleration loads and joints have their stability limits measured with the
+    # constant hold (docs/reliability.md): the linear hold extrapolates an inertia load that
+    # alternates from step to step, and joints' default springs are designed for the constant one
+    held = [w for w, has in (("explicit acceleration loads", any(b.accel_mode == "explicit" for b in bodies.values())),
+                             ("joints", bool(joints))) if has]
+    if free and "load_hold" not in run_cfg["set"] and held:
+        run_cfg["chosen"].append(f"constant load hold kept (the scene has {' and '.join(held)})")
+    elif free and "load_hold" not in run_cfg["set"]:
         run_cfg["load_hold"] = "linear"
         run_cfg["chosen"].append(f"linear load hold (the scene has {because})")
     if restoring and run_cfg["stop"]:

@@ -43,7 +43,7 @@ class Tuning:
         if c.confirmed is not None and self.confirm and self.confirm > self.window + 1e-9:
             text += f", {100 * c.confirmed:.3g} % over {self.confirm:g} s"
             if self.stop and self.confirm < self.stop - 1e-9:
-                text += f" (its last quarter {100 * c.drift:.3g} % of the range there; the stop is {self.stop:g} s)"
+                text += f" (its last quarter {100 * c.drift:.3g} %; the stop is {self.stop:g} s)"
         return text
 
     def run_block(self, stop: float | None = None, keep: Sequence[str] = ()) -> str:

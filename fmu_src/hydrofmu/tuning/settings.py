@@ -75,4 +75,4 @@ class Point:
     source: str = "search"       # 'search', a preset name, 'scene'
     times: list = field(default_factory=list)
     confirmed: float | None = None   # error over the confirmation run (None: not confirmed)
-    drift: float | None = None       # the last quarter's error, of the range there (the drift check)
+    drift: float | None = None       # the last quarter's error (the drift check)
