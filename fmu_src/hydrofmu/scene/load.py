@@ -105,7 +105,7 @@ def _load_scene(path, overrides=None):
     speed, direction, profile = read_current(p, env)
     check_wave_effects(p, bodies, sea, rho, g)
     _check_names(p, bodies, joints, couplings)
-    if None not in (run_cfg["step"], run_cfg["stop"]):
+    if not p.items:   # defaults for what a valid scene holds (a scene with problems is refused below)
         stable_defaults(run_cfg, bodies, couplings, sea,
                         isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"], joints)
     scene = Scene(
