@@ -1,4 +1,6 @@
 """Shared test helpers: write a scene, build its FMUs, find the repository's files."""
+import os
+import shutil
 from pathlib import Path
 import textwrap
 
@@ -22,6 +24,25 @@ s.enterInitializationMode()
 s.exitInitializationMode()
 s.doStep(0.0, 0.05)
 """
+
+
+def in_ci() -> bool:
+    """True in CI (the environment variable CI=true, set by .ci/run and most CI services)."""
+    return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
+
+
+def tools(*names: str, why: str) -> list:
+    """The paths of the programs ``names``.  One missing: the test is skipped with the reason in
+    one line (a fresh machine has Python and cc only, as the README says), except in CI, which
+    installs them (.ci/run) and where the test fails instead: nothing is skipped there."""
+    found = [shutil.which(n) for n in names]
+    missing = [n for n, f in zip(names, found) if f is None]
+    if missing:
+        reason = f"needs {' and '.join(missing)} ({why}; .ci/run installs them)"
+        if in_ci():
+            pytest.fail(f"CI=true but {reason}: not installed", pytrace=False)
+        pytest.skip(reason)
+    return found
 
 
 def open_fmus(folder, manifest):

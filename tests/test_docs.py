@@ -56,3 +56,12 @@ def test_readme_is_a_front_door_whose_links_exist():
     home = (ROOT / "docs" / "index.md").read_text()
     for page in nav:
         assert page == "index.md" or page in home, page
+
+
+def test_the_waves_page_opens_with_the_buoy_scene_as_it_is():
+    """docs/waves.md opens with a complete scene: models/buoy_in_waves.toml, word for word
+    (the demo runs it; a changed scene changes the page)."""
+    page = (ROOT / "docs" / "waves.md").read_text()
+    first = page.split("```toml\n", 1)[1].split("```", 1)[0]
+    assert page.index("```toml") < page.index("\n## Waves (first order)")
+    assert first == (ROOT / "models" / "buoy_in_waves.toml").read_text()

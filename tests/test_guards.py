@@ -310,8 +310,31 @@ def test_bem_warnings_in_the_scene_the_build_and_the_manifest(tmp_path):
     with pytest.warns(InputWarning):
         folder = build_scene(load_scene(write_scene(tmp_path, SMALL, "small.toml")), tmp_path / "fmus",
                              log=lambda *_: None)
-    said = json.loads((folder / "manifest.json").read_text())["warnings"]
+    manifest = json.loads((folder / "manifest.json").read_text())
+    said = manifest["warnings"]
     assert len(said) == 1 and "small.toml: bodies.hull.effects[0].matrix[2,2]: negative diagonal drag" in said[0]
+    assert manifest["warning_count"] == 1
+
+
+def test_each_warning_is_said_once_per_command(tmp_path, monkeypatch):
+    """A command that reads the scene many times (tune: once per candidate; batch: per variant)
+    says each warning once; a run that reuses the build says the build's warnings again, once."""
+    path = write_scene(tmp_path, SMALL, "small.toml")
+    from hydrofmu.scene import load_scene as real_load
+    import hydrofmu.scene as scene_module
+    calls = []
+
+    def load_three_times(*args, **kw):   # as tune and batch do: the same scene read again and again
+        calls.append(1)
+        for _ in range(2):
+            real_load(*args, **kw)
+        return real_load(*args, **kw)
+
+    monkeypatch.setattr(scene_module, "load_scene", load_three_times)
+    code, line, text = cli("run", path, "-o", tmp_path / "out", "--stop", "0.2")
+    assert code == 0 and calls and text.count("negative diagonal drag") == 1, text
+    code, line, text = cli("run", path, "-o", tmp_path / "out", "--stop", "0.2")   # reused: said from the manifest
+    assert code == 0 and text.count("negative diagonal drag") == 1 and text.count("warning:") == 1, text
 
 
 def wamit(tmp_path, rows, name="w.1"):
@@ -465,3 +488,19 @@ def test_a_broken_build_folder_is_named_not_an_internal_error(tmp_path, demo_bui
         assert code == 2 and words in line and not (tmp_path / "r.csv").exists()
         with pytest.raises(InputError, match=words.split(": ", 1)[1]):
             hydrofmu.run(folder)
+
+
+def test_one_mismatch_is_stated_once_with_plain_numbers(tmp_path):
+    """The buoy of models/ 1 m below the rotation centre of its BEM file, which a coupling and
+    two effects read: one statement of that mismatch (not one per reader, nor the centre of
+    mass that moved with it), numbers printed as numbers (no np.float64 reprs)."""
+    text = (MODELS / "buoy_in_waves.toml").read_text().replace(
+        '"decks/buoy.nc"', f'"{(MODELS / "decks" / "buoy.nc").as_posix()}"').replace(
+        "position = [0.0, 0.0, 0.0]", "position = [0.0, 0.0, -1.0]")
+    path = write_scene(tmp_path, text, "moved.toml")
+    code, line, _ = cli("build", "--check", path)
+    assert code == 2 and line.count("rotation_center") == 1 and line.count("; ") == 0, line
+    assert "np.float64" not in line and "center_of_mass" not in line
+    assert "rotation_center[buoy]: [0, 0, 0] m in the file but the reference point of scene body 'buoy' is at " \
+           "[0, 0, -1] m (bodies.buoy.position)" in line
+    assert len(line) < 400, len(line)

@@ -478,3 +478,27 @@ def test_run_rows_beyond_memory_are_refused_before_the_run(demo_build, monkeypat
     with pytest.raises(InputError) as err:
         run(demo_build, stop=1.0)
     assert err.value.field == "run.stop" and "output values would need" in err.value.message
+
+
+def test_components_beyond_the_compiled_limit_are_refused(tmp_path):
+    """More components than physics/waves.c takes (1e7) is the scene's error for both flavours."""
+    with pytest.raises(InputError) as err:
+        load_scene(wave_scene(tmp_path, 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 20000000'))
+    assert "waves.components: 2e+07 wave components: more than 1e+07" in str(err.value)
+
+
+@pytest.mark.parametrize("knob, said", [
+    ('"waves.hs" = [2.0, 2000.0]', "value 2000.0: 2000 m is beyond any sea"),
+    ('"waves.components" = [100, 1.0e17]', "value 1e+17: 1e+17 wave components would need"),
+])
+def test_batch_sea_knobs_beyond_a_sea_are_refused_before_any_case(tmp_path, knob, said):
+    """waves.* knobs are FMU parameters: the scene's checks never see them; the batch checks
+    each value against the scene's [waves] before any case runs."""
+    shutil.copy(ROOT / "tests" / "data" / "bem" / "wave_cylinder.nc", tmp_path / "wave_cylinder.nc")
+    scene = wave_scene(tmp_path, 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0')
+    cases = tmp_path / "cases.toml"
+    cases.write_text(f'scene = "w.toml"\nstop = 10.0\noutputs = ["cyl.waves.force[3]"]\n[matrix]\n{knob}\n')
+    assert scene.exists()
+    with pytest.raises(InputError) as err:
+        check_knobs(load_cases(cases))
+    assert err.value.field == knob.split('"')[1] and said in err.value.message, err.value

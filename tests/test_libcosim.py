@@ -73,6 +73,12 @@ def test_libcosim_honours_the_scenes_outputs_and_interval(tmp_path):
                      "--csv", str(tmp_path / f"{engine}.csv")]) == 0
     assert (tmp_path / "fmpy.csv").read_text().splitlines()[0] == (tmp_path / "libcosim.csv").read_text().splitlines()[0]
     assert len((tmp_path / "libcosim.csv").read_text().splitlines()) == 1 + 5
+    # and the same Parquet file beside it (columns, units, rows: Jacobi in both masters)
+    from hydrofmu.cosim.stream import read_parquet
+    mine, theirs = read_parquet(tmp_path / "fmpy.parquet"), read_parquet(tmp_path / "libcosim.parquet")
+    assert theirs.columns == mine.columns and theirs.units == mine.units and len(theirs) == 5
+    assert theirs.manifest["scene"] == "moored_barge" and theirs.settings["algorithm"] == "jacobi"
+    np.testing.assert_allclose(theirs.values, mine.values, rtol=1e-9, atol=1e-9)
     with pytest.raises(InputError, match=r"thin.toml.*run.interval.*ECCO chooses its own time points"):
         libcosim.run(built, stop=2.0, algorithm="ecco")
     with pytest.raises(InputError, match="interval: the output interval must be a whole number of steps"):

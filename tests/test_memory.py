@@ -3,7 +3,7 @@ import json
 
 import numpy as np
 import pytest
-from scipy.integrate import quad
+from scipy.integrate import quad, trapezoid
 from scipy.linalg import expm
 
 from hydrofmu.physics import memory
@@ -334,3 +334,174 @@ def test_filling_history_weights_are_the_direct_ones():
     got = np.array([c.advance(h, vk) for h, vk in zip(steps, v)])
     ref = np.array([direct.advance(h, vk) for h, vk in zip(steps, v)])
     assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+# ---------------------------------------------------------------- a realisation that cannot explode
+
+ISSUE_KERNEL = np.array([0.0, -1e4, -8e3, -2e3, 0.0])   # issue 31: a SIMO cross kernel, TIMDEL 0.5 s
+
+
+def area_abs(h, timdel):
+    """∫|K| dt of the piecewise-linear kernel, piece by piece (a piece that changes sign: two
+    triangles, a²+b² over 2(|a|+|b|) times its length)."""
+    a, b = np.asarray(h[:-1], float), np.asarray(h[1:], float)
+    same = a * b >= 0
+    pieces = np.where(same, 0.5 * (np.abs(a) + np.abs(b)),
+                      (a * a + b * b) / (2 * np.maximum(np.abs(a) + np.abs(b), 1e-300)))
+    return timdel * pieces.sum()
+
+
+def miss(fit, h, timdel, sub=64):
+    """(∫₀^2T |ĥ − K| dt by the trapezoid rule on ``sub`` points per TIMDEL, the grid split at
+    T where K jumps to zero; ∫|ĥ| beyond 2T, on 20001 points up to where the slowest mode has
+    fallen by e^{−40})."""
+    n = len(h)
+    end = timdel * (n - 1)
+    total = 0.0
+    for lo, hi, on in ((0.0, end, True), (end, 2 * end, False)):
+        t = np.linspace(lo, hi, (n - 1) * sub + 1)
+        k = np.interp(t, timdel * np.arange(n), h) if on else np.zeros(t.size)
+        total += trapezoid(np.abs(fit(t) - k), t)
+    t = np.linspace(2 * end, 2 * end + 40.0 / np.min(-np.diag(fit.A)), 20001)
+    return total, trapezoid(np.abs(fit(t)), t)
+
+
+def run_both(h, timdel, steps, rng, **kw):
+    """Loads of StateSpace and Convolution (same kernel, random velocity in [−1, 1] at every
+    communication point, zero at the start) over ``steps``."""
+    ss, conv = StateSpace(h, timdel, **kw), Convolution(h, timdel)
+    v = rng.uniform(-1.0, 1.0, size=len(steps))
+    return ss, np.array([ss.advance(dt, [x])[0] for dt, x in zip(steps, v)]), \
+        np.array([conv.advance(dt, [x])[0] for dt, x in zip(steps, v)])
+
+
+def random_kernel(rng, kind, n):
+    """A kernel of ``kind`` with n samples and a random spacing, scale and shape."""
+    timdel = float(rng.uniform(0.05, 0.5))
+    t = timdel * np.arange(n)
+    span = max(t[-1], timdel)
+    scale = 10.0 ** rng.uniform(2, 9)
+    if kind == "short":                                       # anything: 3–5 random samples
+        h = rng.normal(size=n)
+    elif kind == "smooth":
+        b = rng.uniform(1.0, 8.0) / span
+        h = np.exp(-b * t) * (1.0 + rng.uniform(0, 3) * b * t)
+    elif kind == "oscillating":                               # up to 0.8 of Nyquist
+        b, w = rng.uniform(0.5, 6.0) / span, rng.uniform(0.05, 0.8) * np.pi / timdel
+        h = np.exp(-b * t) * np.cos(w * t + rng.uniform(0, np.pi))
+    elif kind == "sign-changing":
+        b1, b2 = rng.uniform(2.0, 10.0, size=2) / span
+        h = np.exp(-b1 * t) - rng.uniform(0.5, 1.5) * np.exp(-b2 * t) * np.cos(rng.uniform(0, 3) * b2 * t)
+    else:                                                     # cross: two bodies' dispersive echo
+        from hydrofmu.bench.kernels import damping_kernel
+        h = damping_kernel(t * 20.0 / span, 1.0, rng.uniform(0.5, 1.2), distance=rng.uniform(10.0, 60.0))
+    return scale * h, timdel
+
+
+def kernel_cases():
+    rng = np.random.default_rng(31)
+    cases = [("issue", ISSUE_KERNEL, 0.5, 0.002), ("issue", ISSUE_KERNEL, 0.5, 0.01),
+             ("issue, first sample dropped", ISSUE_KERNEL[1:], 0.5, 0.002)]
+    lengths = {"short": (3, 4, 5, 3, 5), "smooth": (6, 40, 300, 2000), "oscillating": (8, 30, 200, 600),
+               "sign-changing": (5, 25, 120, 400), "cross": (60, 300, 2000)}
+    for kind, ns in lengths.items():
+        for n in ns:
+            h, timdel = random_kernel(rng, kind, n)
+            cases.append((kind, h, timdel, float(rng.choice([0.002, 0.01, 0.05]))))
+    return cases
+
+
+@pytest.mark.parametrize("case", kernel_cases(), ids=lambda c: f"{c[0]}-{len(c[1])}-tol{c[3]}")
+def test_state_space_load_stays_within_the_kernels_scale(case):
+    """Property over random kernels (3–2000 samples: smooth, short, oscillating, sign-changing,
+    cross-coupling, and the issue's): at steps that divide TIMDEL and steps that do not, the
+    state-space load differs from the convolution's by at most ∫|ĥ − K| dt·max|v| (both step
+    their kernels exactly for a velocity linear within each step), ∫|ĥ − K| is what the
+    realisation claims (``deviation``·∫|K|), and so |F| ≤ (1 + deviation)·∫|K| dt·max|v|.
+    The promise of the tolerance: a realisation within tol at the samples (one a coupling
+    uses) has deviation ≤ SLACK·(its L1 miss at the samples + what they leave open between
+    them: Δ/12·Σ|second differences| + Δ/2·|last sample|), each computed here by hand."""
+    kind, h, timdel, tol = case
+    rng = np.random.default_rng(len(h))
+    fit = realise(h, timdel, tol)
+    scale = area_abs(h, timdel)                               # ∫|K| dt
+    inside, tail = miss(fit, h, timdel) if fit.order else (scale, 0.0)
+    d = inside + tail                                         # ∫|ĥ − K| dt, at most
+    assert d <= 1.02 * fit.deviation * scale + 1e-12 * scale, (d / scale, fit.deviation)
+    for sig, om in memory._modes(fit.A):                      # what the sampling resolves
+        assert sig < 0 and np.hypot(sig, om) * timdel <= memory.RESOLVED
+    if fit.error <= tol:
+        n = len(h)
+        at = timdel * np.abs(fit(timdel * np.arange(2 * n - 1)) - np.append(h, np.zeros(n - 1))).sum()
+        open_ = timdel * (np.abs(np.diff(h, 2)).sum() / 12 + 0.5 * abs(h[-1]))
+        assert d <= memory.SLACK * (at + tail + open_) * 1.02, (d / scale, at / scale, open_ / scale)
+    span = timdel * (len(h) - 1)
+    patterns = {"TIMDEL": [timdel], "TIMDEL/3": [timdel / 3], "0.2 s": [0.2 if abs(timdel / 0.2 - round(timdel / 0.2)) > 1e-6 else 0.23],
+                "0.37·TIMDEL": [0.37 * timdel], "variable": list(rng.uniform(0.1, 1.3, 50) * timdel)}
+    for name, base in patterns.items():
+        count = int(min(300, np.ceil(1.3 * span / np.mean(base)) + 10))
+        steps = np.resize(base, count)
+        _, fs, fc = run_both(h, timdel, steps, rng, fits={(0, 0): fit})
+        assert np.all(np.abs(fs - fc) <= 1.02 * d + 1e-9 * scale), (name, np.abs(fs - fc).max() / scale, d / scale)
+        assert np.all(np.abs(fs) <= 1.02 * (scale + d)), (name, np.abs(fs).max() / scale)
+        assert np.all(np.abs(fc) <= scale * (1 + 1e-9)), name   # the convolution: ∫|K|·max|v|
+
+
+def test_issue_kernels_stepped_at_steps_not_dividing_timdel():
+    """The issue's kernels stepped at 0.5, 0.2 and 0.07 s (TIMDEL 0.5 s): realised with 16
+    orders of magnitude of cancelling amplitudes (poles at σ ≈ −21 and −26 s⁻¹, |λ|·TIMDEL
+    ≈ 11, 13) the state-space load reached 3e10 and 8e11 N against ~1e4 N by convolution.
+    Now the load stays below (1 + deviation)·∫|K| dt·max|v| (by hand: ∫|K| = 0.5·(1e4 + 8e3
+    + 2e3) = 1e4 and 0.5·(1e4/2 + 8e3 + 2e3) = 7.5e3 N per m/s), within deviation·∫|K|·max|v|
+    of the convolution's."""
+    for h, order, by_hand in ((ISSUE_KERNEL, 4, 1e4), (ISSUE_KERNEL[1:], None, 7.5e3)):
+        assert area_abs(h, 0.5) == pytest.approx(by_hand)
+        for dt in (0.5, 0.2, 0.07):
+            n = int(20 / dt)
+            ss, conv = StateSpace(h, 0.5, order=order), Convolution(h, 0.5)
+            v = np.sin(0.7 * dt * np.arange(1, n + 1))
+            fs = np.array([ss.advance(dt, [x])[0] for x in v])
+            fc = np.array([conv.advance(dt, [x])[0] for x in v])
+            fit = ss.fits[(0, 0)]
+            assert fit.deviation < 0.5 and np.abs(fs).max() <= 1.5 * by_hand   # (was 3e10, 8e11)
+            assert np.abs(fs).max() <= (1 + fit.deviation) * by_hand
+            assert np.abs(fs - fc).max() <= fit.deviation * by_hand
+            assert np.abs(fc).max() > 0.7 * by_hand          # (the velocity drives it: not a trivial bound)
+
+
+def test_coupling_falls_back_to_convolution_once_with_a_warning():
+    """The issue's kernel as the yaw–sway cross kernel of a coupling: at the default tolerance
+    (0.002) no realisation the sampling resolves meets it (order 3: 0.0048), so the coupling
+    steps the exact convolution and says so in one warning naming the coupling, the kernel and
+    why; the build stores it as a convolution.  At 0.01 the three well-behaved poles are used,
+    stepped at 0.2 s within their deviation of the convolution."""
+    import warnings
+    from hydrofmu import description as d
+    from hydrofmu.assembly import fit_memories
+    from hydrofmu.physics.coupling import Coupling
+    kernels = {(6, 2): ISSUE_KERNEL}
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        c = Coupling(np.zeros((6, 6)), 0.5, kernels, method="state_space", tol=0.002, name="barge_tug")
+    msg = [str(w.message) for w in said if issubclass(w.category, memory.MemoryFitWarning)]
+    assert len(msg) == 1 and "barge_tug" in msg[0] and "kernel (6, 2)" in msg[0] and "0.00479 > 0.002" in msg[0], msg
+    assert c.method == "convolution" and isinstance(c.memory["A"], Convolution) and isinstance(c.memory["B"], Convolution)
+    conv = Convolution({(5, 1): ISSUE_KERNEL}, 0.5, shape=(6, 6))
+    for k in range(1, 40):
+        v = np.eye(6)[1] * np.sin(0.7 * 0.2 * k)
+        np.testing.assert_array_equal(c.memory["A"].advance(0.2, v), conv.advance(0.2, v))
+    hc = d.HydroCoupling("barge_tug", "barge", "tug", np.zeros((6, 6)), 0.5, [d.Kernel(6, 2, ISSUE_KERNEL)],
+                         method="state_space", tolerance=0.002)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        fit_memories([hc])
+    assert hc.method == "convolution" and not hc.fits
+    assert sum(issubclass(w.category, memory.MemoryFitWarning) for w in said) == 1
+    c = Coupling(np.zeros((6, 6)), 0.5, kernels, method="state_space", tol=0.01)
+    fit = c.fits[(6, 2)]
+    assert c.method == "state_space" and fit.order == 3 and fit.error < 0.005
+    conv = Convolution({(5, 1): ISSUE_KERNEL}, 0.5, shape=(6, 6))
+    for k in range(1, 100):
+        v = np.eye(6)[1] * np.sin(0.7 * 0.2 * k)
+        f = c.memory["A"].advance(0.2, v)[5]
+        assert abs(f - conv.advance(0.2, v)[5]) <= fit.deviation * 1e4 and abs(f) <= (1 + fit.deviation) * 1e4

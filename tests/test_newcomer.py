@@ -2,6 +2,8 @@
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 
@@ -85,6 +87,44 @@ def test_batch_polar_plot_has_units_and_one_legend_off_the_panels(tmp_path, monk
     assert legend.get_window_extent().y1 <= min(a.get_window_extent().y0 for a in fig.axes)
 
 
+def test_batch_columns_are_the_knobs_as_written_and_poses_plot_without_their_offset(tmp_path, monkeypatch):
+    """Knobs given as ``hs`` and ``wave_direction`` are the table's columns and the plot's names
+    (not waves.hs, waves.direction); a reference point 6 m below the waterline heaving ±0.5 m
+    plots as 0.5 m, not 6.5 m (its initial value taken off), a load as it is."""
+    import pandas as pd
+    from hydrofmu.batch import assemble_table, load_cases, plot
+    batch = load_cases({"scene": str(ROOT / "models" / "buoy_in_waves.toml"),
+                        "outputs": ["buoy_dynamics.position[3]", "buoy.force[3]"],
+                        "matrix": {"hs": [1.0, 2.0], "wave_direction": [0.0, 90.0]}}, tmp_path)
+    assert batch.keys == ["waves.hs", "waves.direction"] and batch.column("waves.direction") == "wave_direction"
+    import json
+    (tmp_path / "cases").mkdir()
+    ids = []
+    for hs in (1.0, 2.0):
+        for d in (0.0, 90.0):
+            cid = f"c{int(hs)}{int(d)}"
+            ids.append(cid)
+            stats = {"buoy_dynamics.position[3].max": -6.0 + hs / 2, "buoy_dynamics.position[3].min": -6.0 - hs / 2,
+                     "buoy_dynamics.position[3].initial": -6.0,
+                     "buoy.force[3].max": 1e3 * hs, "buoy.force[3].min": -2e3 * hs, "buoy.force[3].initial": 0.0}
+            (tmp_path / "cases" / f"{cid}.json").write_text(json.dumps(
+                {"case": cid, "knobs": {"waves.hs": hs, "waves.direction": d}, "status": "ok", "error": None,
+                 "wall_s": 1.0, "stats": stats, "build": "b"}))
+    figs = _figures(monkeypatch)
+    table = assemble_table(tmp_path, ids, batch, {"buoy_dynamics.position[3]": "m", "buoy.force[3]": "N"})
+    assert list(table.columns[:2]) == ["hs", "wave_direction"] and "waves.hs" not in table.columns
+    figs.clear()
+    plot(table, batch, tmp_path / "again.png", {"buoy_dynamics.position[3]": "m", "buoy.force[3]": "N"})
+    (fig,) = figs
+    pose, load = fig.axes[:2]
+    assert pose.get_title() == "max |buoy_dynamics.position[3] − initial| [m]"
+    assert load.get_title() == "max |buoy.force[3]| [N]"
+    assert sorted(max(line.get_ydata()) for line in pose.get_lines()) == [0.5, 1.0]   # not 6.5 and 7
+    assert sorted(max(line.get_ydata()) for line in load.get_lines()) == [2e3, 4e3]
+    assert fig._suptitle.get_text().startswith("buoy_in_waves: largest value per case against wave_direction")
+    assert fig.legends[0].get_title().get_text().startswith("hs")
+
+
 def test_bem_quality_plot_has_y_units_and_readable_text(tmp_path, monkeypatch):
     from hydrofmu.bem import couplings, plot_quality
     from hydrofmu.decks.bem import read_bem
@@ -98,3 +138,21 @@ def test_bem_quality_plot_has_y_units_and_readable_text(tmp_path, monkeypatch):
     assert ("B: cyl1__Roll, cyl1__Roll", "B [kg·m²/s]") in labels
     assert ("A: cyl1__Sway, cyl1__Roll", "A [kg·m]") in labels
     assert min(a.title.get_fontsize() for a in fig.axes) >= 9
+
+
+def test_a_missing_cross_compiler_skips_on_a_fresh_machine_and_fails_in_ci(tmp_path, monkeypatch):
+    """A machine with Python and cc only (the README's prerequisites): a test that needs
+    mingw-w64 or wine is skipped with its reason in one line; in CI (CI=true, .ci/run
+    installs them) the same test fails."""
+    from conftest import tools
+    monkeypatch.setenv("PATH", str(tmp_path))   # nothing to be found
+    monkeypatch.delenv("CI", raising=False)
+    with pytest.raises(pytest.skip.Exception) as skipped:
+        tools("wine", "x86_64-w64-mingw32-gcc", why="the win64 DLL run under wine")
+    reason = str(skipped.value)
+    assert "\n" not in reason and reason.startswith("needs wine and x86_64-w64-mingw32-gcc (the win64 DLL")
+    monkeypatch.setenv("CI", "true")
+    with pytest.raises(pytest.fail.Exception) as failed:
+        tools("wine", why="the win64 DLL run under wine")
+    assert str(failed.value).startswith("CI=true but needs wine")
+    assert "export CI=true" in (ROOT / ".ci" / "run").read_text()

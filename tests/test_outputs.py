@@ -104,6 +104,35 @@ def test_csv_headers_carry_units_and_read_back(demo_build, tmp_path):
     assert split_header("x.force[1]") == ("x.force[1]", "") and split_header("a [-]") == ("a", "")
 
 
+def test_time_axis_reads_minutes_and_hours_for_long_records():
+    from hydrofmu.cosim.report import time_axis
+    t, label = time_axis(np.arange(0.0, 600.1, 0.1))
+    assert label == "time [s]" and t[-1] == pytest.approx(600.0)
+    t, label = time_axis(np.arange(0.0, 1800.1, 0.1))            # 30 minutes
+    assert label == "time [min]" and t[-1] == pytest.approx(30.0)
+    t, label = time_axis(np.arange(0.0, 4 * 3600.0 + 1, 1.0))    # 4 hours
+    assert label == "time [h]" and t[-1] == pytest.approx(4.0)
+
+
+def test_a_panel_of_round_off_says_so_instead_of_magnifying_it():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from hydrofmu.cosim.report import _panel, round_off
+    t = np.linspace(0.0, 100.0, 1001)
+    mz = [("waves", 2, 1e-13 * np.sin(t)), ("total", 2, 1.2e-13 * np.sin(t))]   # kN·m, beside a 3000 kN·m pitch moment
+    assert round_off(mz, 3000.0) == pytest.approx(1.2e-13, rel=1e-3)
+    assert round_off(mz, 1e-4) is None          # 1.2e-13 is more than 1e-9 of a 1e-4 scale: a load, not round-off
+    assert round_off([("waves", 2, np.zeros_like(t))], 3000.0) is None       # zero is said as zero
+    fig, (noise, real) = plt.subplots(1, 2)
+    _panel(noise, t, mz, "yaw moment Mz [kN·m]", {}, scale=3000.0, unit="kN·m")
+    assert [x.get_text() for x in noise.texts] == ["round-off only: |value| ≤ 1.2e-13 kN·m"]
+    assert noise.get_ylim() == (-1.0, 1.0)
+    _panel(real, t, [("waves", 2, 50 * np.sin(t))], "yaw moment Mz [kN·m]", {}, scale=3000.0, unit="kN·m")
+    assert not real.texts and real.get_ylim()[1] == pytest.approx(60.0, rel=0.01)   # ±50 widened by 10 % of 100
+    plt.close(fig)
+
+
 def _hydrofmu(*args, cwd):
     return subprocess.run([sys.executable, "-m", "hydrofmu.cli", *args], cwd=cwd, capture_output=True,
                           text=True, timeout=300)
@@ -124,7 +153,10 @@ def test_run_writes_csv_png_and_summary_next_to_the_build_and_says_where(tmp_pat
     # the run's settings once, without a "preset none"; the summary printed and written
     text = done.stdout + done.stderr
     assert text.count("step 0.1 s, gauss-seidel") == 1 and "preset none" not in text
-    assert "summary of moored_barge" in done.stdout and "barge  total" in done.stdout
+    assert "summary of moored_barge (Python flavour)" in done.stdout and "barge  total" in done.stdout
+    # which flavour ran: in the settings line, the summary's JSON and the manifest
+    assert text.count("; Python flavour (pythonfmu FMUs)") == 1
+    assert json.loads(summary.read_text())["flavour"] == "Python"
     stats = json.loads(summary.read_text())["bodies"]["barge"]
     fx = result["barge.force[1]"]
     assert stats["total"]["Fx"]["unit"] == "N" and stats["total"]["Fx"]["max"] == fx.max()

@@ -297,3 +297,53 @@ def test_bem2simo_reads_a_wamit_one_in_omega(tmp_path, capsys):
     assert len(p) == len(w) > 1000        # 9 digits written: ω from the period differs in the 9th
     np.testing.assert_allclose(w, p, rtol=1e-6, atol=1e-6 * np.max(np.abs(p)))
     capsys.readouterr()
+
+
+def test_scene_period_variable_next_to_the_file(tmp_path):
+    """`period_variable` beside a WAMIT file in a scene: a coupling's .1 written in ω gives the
+    couplings of the same file written in periods; a wave_excitation's .3 in Hz the same
+    transfer function; the key on a Capytaine dataset, or a value not in the list, is an error."""
+    from conftest import write_scene
+    from test_bem import bodies_text
+    from hydrofmu.scene import load_scene
+    write_one(tmp_path / "p.1", limits=False)
+    write_one(tmp_path / "w.1", "omega", limits=False)
+    coupling = lambda f, extra: bodies_text() + f"""
+        [[couplings]]
+        bem = "{f}"
+        ulen = {ULEN}
+        bodies = {{ body1 = "a", body2 = "b" }}
+        rotation_centers = {{ body1 = [0.0, -4.0, 0.0], body2 = [0.0, 4.0, 0.0] }}
+        kernel_length = 30.0
+        {extra}
+        """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = load_scene(write_scene(tmp_path, coupling("p.1", ""), "p.toml"))
+        w = load_scene(write_scene(tmp_path, coupling("w.1", 'period_variable = "omega"'), "w.toml"))
+    for cp, cw in zip(p.couplings, w.couplings):
+        np.testing.assert_allclose(cw.added_mass, cp.added_mass, rtol=1e-6, atol=1e-6 * np.abs(cp.added_mass).max())
+        for kp, kw in zip(cp.kernels, cw.kernels):
+            np.testing.assert_allclose(kw.values, kp.values, rtol=0, atol=1e-6 * np.abs(kp.values).max())
+    with pytest.raises(InputError, match=r"couplings\[0\].period_variable: expected one of 'period', 'omega'"):
+        load_scene(write_scene(tmp_path, coupling("w.1", 'period_variable = "Hz"'), "bad.toml"))
+    with pytest.raises(InputError, match="period_variable: applies to a nondimensional WAMIT .1 file only"):
+        load_scene(write_scene(tmp_path, bodies_text() + f"""
+            [[couplings]]
+            bem = "{CYL}"
+            bodies = {{ cyl1 = "a", cyl2 = "b" }}
+            period_variable = "omega"
+            """, "cap.toml"))
+    from hydrofmu.scene.effects import _wave_excitation
+    from hydrofmu.scene.problems import Problems
+    write_three(tmp_path / "h.3", "hz", limits=False)
+    write_three(tmp_path / "t.3")
+    got = {}
+    for f, extra in (("h.3", {"period_variable": "hz"}), ("t.3", {})):
+        problems = Problems(tmp_path / "s.toml")
+        problems.env = {"rho": RHO, "g": G}
+        got[f] = _wave_excitation(problems, {"type": "wave_excitation", "bem": f, "body": "body2", "ulen": ULEN,
+                                             **extra}, "bodies.b.effects[0]")
+        assert not problems.items, problems.items
+    np.testing.assert_allclose(got["h.3"]["omega"], got["t.3"]["omega"], rtol=1e-7)
+    np.testing.assert_allclose(got["h.3"]["re"], got["t.3"]["re"], rtol=0, atol=1e-6 * np.abs(got["t.3"]["re"]).max())

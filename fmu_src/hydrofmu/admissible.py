@@ -160,6 +160,8 @@ WAVE_KEYS_USED = {
     "jonswap": {"hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp", "depth"},
     "pierson_moskowitz": {"hs", "tp", "direction", "spreading", "components", "seed", "ramp", "depth"},
 }
+for _used in WAVE_KEYS_USED.values():   # the kinematics' keys: every spectrum reads them
+    _used |= {"stretching", "points"}
 
 
 def sea_problems(spectrum, values, g=9.81):

@@ -58,7 +58,7 @@ EXPOSED = {"environment.current_speed": "current.speed", "environment.current_di
                                                    "seed", "ramp", "height", "period", "phase")}}
 # statistics of each output; significant = 4·std (the significant value of a narrow-band
 # response, as Hs = 4·sqrt(m0) of the elevation)
-STATS = ("max", "min", "mean", "std", "significant", "final")
+STATS = ("max", "min", "mean", "std", "significant", "final", "initial")
 FILE_KEYS = file_keys.names(file_keys.CASES)
 SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "waves")
 
@@ -77,6 +77,7 @@ class Batch:
     extra: list = field(default_factory=list)
     transient: float = 0.0
     series: bool = False
+    names: dict = field(default_factory=dict)   # canonical key -> the key as the file wrote it (the table's column)
 
     def __len__(self):
         n = math.prod(len(v) for v in self.matrix.values()) if self.matrix else (0 if self.extra else 1)
@@ -98,6 +99,10 @@ class Batch:
         for case in self.extra:
             out.update(dict.fromkeys(case))
         return list(out)
+
+    def column(self, key):
+        """The table's column of a knob: its key as the case file wrote it (``hs``, not ``waves.hs``)."""
+        return self.names.get(key, key)
 
 
 def _canonical(key):
@@ -223,7 +228,7 @@ def load_cases(source, base=None) -> Batch:
         if value is not None and value not in ALGORITHMS:
             p.add(where, f"expected one of {', '.join(map(repr, ALGORITHMS))} (a batch runs on the fmpy master), "
                          f"found {value!r}")
-    batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True)
+    batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True, _written(doc))
     built = scene is not None and scene.is_dir()
     for key in batch.keys:
         first = key.split(".", 1)[0].split("[", 1)[0]
@@ -237,6 +242,17 @@ def load_cases(source, base=None) -> Batch:
                        "or stop/step/algorithm")
     p.raise_if_any()
     return batch
+
+
+def _written(doc):
+    """{canonical key: the key as written} of a case file's knobs (the first spelling met)."""
+    names = {k: k for k in ("stop", "step", "algorithm") if k in doc}
+    tables = [doc.get("set"), doc.get("matrix")] + list(doc.get("cases") or [])
+    for table in tables:
+        if isinstance(table, dict):
+            for key, _ in _flat(table):
+                names.setdefault(_canonical(key), key)
+    return {_canonical(k): v for k, v in names.items()}
 
 
 def _first_values(batch):
@@ -280,6 +296,7 @@ def check_knobs(batch):
         _check_transient(batch, run)
     else:
         doc = read_toml(batch.scene, "scene")
+        _check_sea_knobs(batch, doc)
         first = {k: v for k, v in _first_values(batch).items()
                  if k.split(".", 1)[0].split("[", 1)[0] in SCENE_SECTIONS and k not in EXPOSED}
         for key, value in first.items():
@@ -300,6 +317,32 @@ def check_knobs(batch):
                 return None   # the scene's own error is every case's
         _check_transient(batch, run)
     _check_case_steps(batch, run)
+
+
+def _check_sea_knobs(batch, doc):
+    """Every value of a ``waves.*`` knob (FMU parameters: the scene's checks never see them)
+    against what a sea can be and the memory (admissible.sea_problems, the scene's component
+    limit), the scene's other [waves] values kept: one InputError naming the knob and value."""
+    from .admissible import sea_problems, size_problem
+    from .scene.waves import COMPONENT_BYTES, MAX_COMPONENTS
+    waves = doc.get("waves")
+    if not isinstance(waves, dict):
+        return
+    spectrum = waves.get("spectrum", "jonswap")
+    for key in batch.keys:
+        if not key.startswith("waves."):
+            continue
+        name = key.split(".", 1)[1]
+        values = list(batch.matrix.get(key, [])) + [c[key] for c in [batch.fixed, *batch.extra] if key in c]
+        for value in values:
+            if _kind(value) != "a number":
+                continue
+            errors = [m for k, m in sea_problems(spectrum, {**waves, name: value})[0] if k == name]
+            if name == "components" and spectrum != "regular":
+                big = size_problem(value, COMPONENT_BYTES, "wave components")
+                errors += [big] if big else [f"more than {MAX_COMPONENTS:.0e}"] if value > MAX_COMPONENTS else []
+            if errors:
+                raise InputError(batch.path, None, key, f"value {value!r}: {errors[0]}")
 
 
 def _check_transient(batch, run):
@@ -507,13 +550,15 @@ def _materialize(blob):
 
 
 def statistics(time_, values, outputs, transient=0.0):
-    """{'<output>.max|min|mean|std|final': value} over the samples with t ≥ transient
-    (mean and std: plain sample statistics, the steps being equal)."""
+    """{'<output>.max|min|mean|std|significant|final': value} over the samples with t ≥ transient
+    (mean and std: plain sample statistics, the steps being equal); ``initial``: the value at the
+    start of the run (a body's position: its static pose, which the plot leaves out)."""
     keep = values[time_ >= transient - 1e-9 * max(1.0, abs(transient))]
     out = {}
     for j, name in enumerate(outputs):
         col = keep[:, j]
-        for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), 4 * col.std(), col[-1])):
+        for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), 4 * col.std(), col[-1],
+                                       values[0, j])):
             out[f"{name}.{stat}"] = float(value)
     return out
 
@@ -841,11 +886,12 @@ def assemble_table(out, ids, batch, units=None, kept=None, log=print):
     rows = []
     for cid in ids:
         r = (kept or {}).get(cid) or json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
-        rows.append({**{k: _cell(v) for k, v in r["knobs"].items()}, "status": r["status"], "wall_s": r["wall_s"],
-                     "linear_range": r.get("linear_range"), "max_tilt_deg": r.get("max_tilt_deg"),
+        rows.append({**{batch.column(k): _cell(v) for k, v in r["knobs"].items()}, "status": r["status"],
+                     "wall_s": r["wall_s"], "linear_range": r.get("linear_range"), "max_tilt_deg": r.get("max_tilt_deg"),
                      **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
     stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
-    columns = batch.keys + ["status", "wall_s", "linear_range", "max_tilt_deg"] + stats + ["error", "case", "build"]
+    columns = ([batch.column(k) for k in batch.keys] + ["status", "wall_s", "linear_range", "max_tilt_deg"] + stats
+               + ["error", "case", "build"])
     table = pd.DataFrame(rows, columns=columns)
     written = {}
     for name, write in (("cases.csv", lambda p: table.to_csv(p, index=False)),
@@ -865,11 +911,13 @@ def _cell(value):
 DIRECTION_HINTS = ("direction", "heading")
 
 
-def _with_unit(knob):
-    """``'environment.current_speed [m/s]'``: a knob with the unit its key states."""
+def _with_unit(knob, written=None):
+    """``'environment.current_speed [m/s]'``: a knob (named ``written``, default its key) with the
+    unit its key states."""
     from .keys import unit
     u = unit(knob)
-    return f"{knob} [{u}]" if u else knob
+    name = written or knob
+    return f"{name} [{u}]" if u else name
 
 
 def _emptiest(directions):
@@ -883,11 +931,19 @@ def _emptiest(directions):
     return float(np.mod(d[k] + gaps[k] / 2, 360.0))
 
 
+def _is_pose(output):
+    """A dynamics partner's position or attitude column: its static pose is not a response."""
+    return "_dynamics." in output and any(f".{w}[" in output or output.split(".")[-1].startswith(f"{w}[")
+                                          for w in ("position", "attitude"))
+
+
 def plot(table, batch, path, units=None):
     """Largest |output| per case: a polar plot against the first direction knob (one line per
     combination of the other knobs, one legend for the figure below the panels), else against
-    the first numeric knob; ``units``: output -> unit, in each panel's title.  None if there
-    is nothing to plot."""
+    the first numeric knob; ``units``: output -> unit, in each panel's title.  A body's position
+    and attitude are taken from their initial value (the static pose: a reference point 6 m
+    below the waterline is no 6 m response).  Knobs are named as the case file wrote them.  None
+    if there is nothing to plot."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -896,15 +952,20 @@ def plot(table, batch, path, units=None):
                and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in batch.matrix[k])]
     if ok.empty or not numeric:
         return None
-    axis = next((k for k in numeric if any(h in k.lower() for h in DIRECTION_HINTS)), numeric[0])
-    polar = any(h in axis.lower() for h in DIRECTION_HINTS)
-    others = [k for k in batch.matrix if k != axis and len(batch.matrix[k]) > 1]
+    key = next((k for k in numeric if any(h in batch.column(k).lower() or h in k.lower() for h in DIRECTION_HINTS)),
+               numeric[0])
+    polar = any(h in batch.column(key).lower() or h in key.lower() for h in DIRECTION_HINTS)
+    axis = batch.column(key)
+    other_keys = [k for k in batch.matrix if k != key and len(batch.matrix[k]) > 1]
+    others = [batch.column(k) for k in other_keys]
     units = units or {}
     n = len(batch.outputs)
     fig, axes = plt.subplots(1, n, figsize=(5 * n, 5.4), squeeze=False,
                              subplot_kw={"projection": "polar"} if polar else {})
     for ax, name in zip(axes[0], batch.outputs):
-        peak = np.maximum(ok[f"{name}.max"].abs(), ok[f"{name}.min"].abs())
+        pose = _is_pose(name) and f"{name}.initial" in ok
+        start = ok[f"{name}.initial"].fillna(0.0) if pose else 0.0
+        peak = np.maximum((ok[f"{name}.max"] - start).abs(), (ok[f"{name}.min"] - start).abs())
         groups = ok.groupby(others, sort=True) if others else [((), ok)]
         for label, g in groups:
             g = g.sort_values(axis)
@@ -913,17 +974,18 @@ def plot(table, batch, path, units=None):
             label = ", ".join(f"{v}" for v in (label if isinstance(label, tuple) else (label,)))
             ax.plot(x, y, "o-", label=label or None)
         unit = units.get(name)
-        ax.set_title(f"max |{name}|" + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=9, pad=14)
+        what = f"max |{name} − initial|" if pose else f"max |{name}|"
+        ax.set_title(what + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=9, pad=14)
         ax.tick_params(labelsize=8)
         if polar:   # radial values in the middle of the widest sector without data: they cover no line
             ax.set_rlabel_position(_emptiest(ok[axis].to_numpy(float)))
         else:
-            ax.set_xlabel(_with_unit(axis))
+            ax.set_xlabel(_with_unit(key, axis))
             ax.grid(True, alpha=0.3)
     if others:   # one legend for the figure, below the panels: it covers no label
         handles, labels = axes[0][0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
-                   title=", ".join(map(_with_unit, others)), title_fontsize=8)
+                   title=", ".join(_with_unit(k, c) for k, c in zip(other_keys, others)), title_fontsize=8)
     fig.suptitle(f"{batch.scene.stem}: largest value per case against {axis}"
                  + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10, y=0.98)
     fig.tight_layout(rect=(0, 0.1 if others else 0, 1, 0.92))

@@ -151,7 +151,8 @@ def couplings(data, bodies, dofs=None, timdel=None, length=None, symmetry_tol=SY
                          f"√(A_ii·A_jj) > {100 * exc.tol:g} % (symmetry_tolerance)") from None
     except GridError as exc:
         raise InputError(path, None, exc.field, str(exc)) from None
-    checks = _negative_damping(data, keep, [label(bodies[b], k) for b, k in kept])
+    checks = _negative_damping(data, [i for r, i in enumerate(keep) if rad.active[r, r]],
+                               [label(bodies[b], k) for r, (b, k) in enumerate(kept) if rad.active[r, r]])
     samples = rad.kernels.shape[-1] - 1
     if samples < KERNEL_MIN_STEPS:
         checks.append(f"{path}: kernel length {samples * rad.timdel:g} s is only {samples} TIMDEL ({rad.timdel:g} s): "
@@ -183,7 +184,9 @@ NEGATIVE_DAMPING = 1e-3   # B_ii(ω) below −this × max|B_ii| is said out loud
 
 def _negative_damping(data, keep, labels):
     """Warnings for diagonal radiation damping B_ii(ω) < 0 beyond noise: energy flowing into
-    the body from the waves it radiates, unphysical for a radiation problem."""
+    the body from the waves it radiates, unphysical for a radiation problem.  ``keep``: the
+    dofs the transform kept (a dof it found negligible, e.g. an axisymmetric body's yaw at
+    1e-26, is noise whatever its sign)."""
     out = []
     for r, i in enumerate(keep):
         b = data.damping[:, i, i]

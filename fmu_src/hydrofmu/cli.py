@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | tune | batch | validate | demo | bench | bem2simo`` (a thin layer
+"""Command line: ``hydrofmu build | run | tune | batch | validate | demo | bench | bem2simo | meandrift`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
 import math
@@ -93,7 +93,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
     t ≥ ``transient``.  fmpy runs stream their rows into the CSV and ``parquet`` (default:
     beside the CSV when pyarrow is installed) as they go, and the PNG and the summary are
-    read from the file; a libcosim run is written after it ends.  A write that fails after
+    read from the file; a libcosim run writes the same files after it ends.  A write that fails after
     the run goes to a fallback folder: ``written`` maps each asked path to the one written."""
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
@@ -106,8 +106,11 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
+    if parquet is None and csv is not None and _has_pyarrow():
+        parquet = Path(csv).with_suffix(".parquet")
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
+        check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))
         say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
         try:
             result = run(folder, **kw)
@@ -116,11 +119,12 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         result.written = {}
         if csv:
             result.written[Path(csv)] = keep(result.to_csv, csv, log)[0]
+        if parquet:   # the files an fmpy run writes, written when the run ends
+            from .cosim.stream import write_parquet
+            result.written[Path(parquet)] = write_parquet(result, parquet, log)
         return _plot_and_summary(result, png, summary, transient, log)
     from .cosim.master import run
     from .cosim.stream import Sink
-    if parquet is None and csv is not None and _has_pyarrow():
-        parquet = Path(csv).with_suffix(".parquet")
     check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
     from .cosim.master import RunError
@@ -446,7 +450,7 @@ def make_parser():
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "hold", "bem",
-                            "robust", "batch", "ecco", "longrun", "waves"),
+                            "robust", "batch", "ecco", "longrun", "waves", "kinematics", "drift"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="a smoke run of the cheaper parts at small sizes (about a minute of CPU; the "
                         "parts it leaves out are named), not the documented figures")
@@ -469,6 +473,22 @@ def make_parser():
                    help="WAMIT: what the file's first column is, as the run's IPEROUT wrote it (default period; "
                         "wavenumber: KL = ω²L/g with g = 9.81)")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
+    d = sub.add_parser("meandrift", formatter_class=fmt,
+                       help="add Capytaine's far-field mean drift to a Capytaine dataset (needs the bem-solve extra)",
+                       description="Solve the dataset's diffraction (and radiation) problems again on the body's mesh "
+                                   "with Kochin functions, check the excitation against the dataset's, and write the "
+                                   "dataset with post_pro.far_field_mean_drift_force's drift_force_surge/sway/yaw "
+                                   "(read by the wave_drift effect).")
+    d.add_argument("dataset", type=Path, help="Capytaine dataset (.nc) of one body, with its diffraction problems")
+    d.add_argument("--mesh", required=True, type=Path, help="the body's mesh (any format cpt.load_mesh reads)")
+    d.add_argument("-o", "--out", required=True, type=Path, help="dataset to write (the input plus the drift)")
+    d.add_argument("--fixed", action="store_true", help="a held body: no motions (diffraction only)")
+    d.add_argument("--ntheta", type=int, default=361, help="Kochin directions over the circle")
+    d.add_argument("--no-lid", action="store_true", help="no interior lid (irregular frequencies not removed)")
+    d.add_argument("--omega", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="only the dataset's frequencies in [LO, HI] rad/s (default: all)")
+    d.add_argument("--every", type=int, default=1, help="every N-th of those frequencies")
+    d.add_argument("--directions", nargs="+", type=float, help="only these headings [deg] of the dataset")
     return parser
 
 
@@ -476,6 +496,7 @@ def main(argv=None):
     """The command line; returns the exit code: 0 done, 1 a run or validation failed,
     2 bad input (one ``error:`` line naming the file, line or key path and field),
     3 an internal error (one line; HYDROFMU_DEBUG=1 shows the traceback)."""
+    _SAID.clear()   # each warning once per command: `tune` and `batch` read the scene again per case
     with warnings.catch_warnings():
         warnings.simplefilter("always", InputWarning)
         warnings.showwarning = _show_warning
@@ -495,11 +516,20 @@ def main(argv=None):
             return 3
 
 
+# the warnings this command said: each once, however often the scene is read (tune and batch
+# read it once per candidate or variant)
+_SAID = set()
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    if issubclass(category, InputWarning):
-        print(f"warning: {message}", file=sys.stderr)
-    else:
-        print(f"warning: {category.__name__}: {message}", file=sys.stderr)
+    _say_warning(f"warning: {message}" if issubclass(category, InputWarning) else
+                 f"warning: {category.__name__}: {message}")
+
+
+def _say_warning(text):
+    if text not in _SAID:
+        _SAID.add(text)
+        print(text, file=sys.stderr)
 
 
 def _main(argv):
@@ -517,6 +547,8 @@ def _main(argv):
         if reuse is not None:
             folder = reuse
             print(f"reusing {folder}: the scene, its decks and hydrofmu are unchanged since it was built")
+            for text in read_manifest(folder).get("warnings", []):   # the build's: said again, once
+                _say_warning(f"warning: {text}")
         elif folder.suffix == ".toml":
             from .scene import load_scene
             scene = load_scene(folder)
@@ -562,6 +594,14 @@ def _main(argv):
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
                         args.symmetry_tolerance, args.png, a_inf=args.a_inf, period_variable=args.period_variable)
         return _wrote(made)[1]
+    elif args.command == "meandrift":
+        from .bem_drift import add_mean_drift
+        if args.ntheta < 16:
+            raise InputError("command line", None, "--ntheta", f"at least 16 directions, found {args.ntheta}")
+        check_outputs(files=(args.out,), inputs=(args.dataset, args.mesh))
+        keep(lambda p: add_mean_drift(args.dataset, args.mesh, p, fixed=args.fixed, ntheta=args.ntheta,
+                                      lid=not args.no_lid, omega_range=args.omega, every=args.every,
+                                      directions=args.directions), args.out, _stderr)
     elif args.command == "bench":
         from .bench.run import main as bench
         check_folder(args.out)

@@ -13,6 +13,7 @@ it at instantiation.
 from __future__ import annotations
 
 import json
+import math
 import types
 import typing
 from dataclasses import dataclass, field, fields, is_dataclass
@@ -133,27 +134,76 @@ class Waves:
     """The scene's wave field as one body's FMU sees it (physics.waves): the sea state
     ``spectrum`` and its knobs ``sea`` (SeaState fields: start values of the ``waves.*``
     parameters), the frequency ``window`` [rad/s] common to every body of the scene (so
-    that all draw the same components), and this body's excitation transfer function per
-    unit amplitude: ``omega`` [rad/s], ``directions`` [deg], ``re`` + i·``im`` (nω, nβ, 6)
-    [N/m, N·m/m], e^{+iωt}, referred to the global origin; ``position`` (x, y) [m] its mean
-    position; effect ``name`` (outputs ``<name>.force``, ``<name>.elevation``)."""
-    name: str
+    that all draw the same components; None: no excitation in the scene, the whole spectrum),
+    and, with an excitation effect ``name`` (outputs ``<name>.force``, ``<name>.elevation``; None:
+    none on this body), this body's transfer function per unit amplitude: ``omega`` [rad/s],
+    ``directions`` [deg], ``re`` + i·``im`` (nω, nβ, 6) [N/m, N·m/m], e^{+iωt}, referred to the
+    global origin; ``position`` (x, y) [m] its mean position.  ``kinematics``: an effect of
+    this FMU feels the incident-wave kinematics (physics/wave_kinematics.py); ``points``: the
+    named points whose kinematics it outputs, {name: {"position": global (3)} or {"offset":
+    body axes (3)}}."""
+    name: str | None
     spectrum: str
     sea: dict
-    window: list[float]
-    omega: np.ndarray
-    directions: np.ndarray
-    re: np.ndarray
-    im: np.ndarray
-    position: np.ndarray
+    window: list[float] | None
+    omega: np.ndarray | None = None
+    directions: np.ndarray | None = None
+    re: np.ndarray | None = None
+    im: np.ndarray | None = None
+    position: np.ndarray | None = None
+    kinematics: bool = False
+    points: dict = field(default_factory=dict)
 
     def sea_state(self, **knobs):
         from .physics.waves import SeaState
         return SeaState(self.spectrum, **{**self.sea, **knobs})
 
     def transfer(self, g, depth):
+        """The body's TransferFunction, or None (no excitation on this body)."""
         from .physics.waves import TransferFunction
+        if self.name is None:
+            return None
         return TransferFunction(self.omega, self.directions, self.re + 1j * self.im, self.position, g, depth)
+
+
+@dataclass
+class Drift:
+    """A body's second-order wave drift (physics.drift) on the scene's wave field (the same
+    components as its ``Waves``): effect ``name`` (output ``<name>.force``), ``method``
+    mean | newman | qtf, ``cutoff`` [rad/s] (qtf: the largest |ω_i − ω_j| kept; inf: all),
+    ``omega`` [rad/s]; mean drift data: ``directions`` [deg] and ``values`` (nω, nβ, 6)
+    [N/m², N·m/m²]; QTF data: ``pairs`` (nP, 2) [deg] and ``re`` + i·``im`` (nω, nω, nP, 6),
+    referred to the global origin; ``position`` (x, y) [m] the body's mean position."""
+    name: str
+    method: str
+    cutoff: float
+    omega: np.ndarray
+    position: np.ndarray
+    directions: np.ndarray | None = None
+    values: np.ndarray | None = None
+    pairs: np.ndarray | None = None
+    re: np.ndarray | None = None
+    im: np.ndarray | None = None
+
+    def data(self, g, depth):
+        """physics.drift.QTF or MeanDrift of this body."""
+        from .physics.drift import QTF, MeanDrift
+        if self.pairs is not None:
+            return QTF(self.omega, [tuple(p) for p in self.pairs], self.re + 1j * self.im, self.position, g, depth)
+        return MeanDrift(self.omega, self.directions, self.values)
+
+    def kernel(self, comps, g, depth):
+        """physics.drift.DriftLoad of the components ``comps``."""
+        from .physics.drift import DriftLoad
+        return DriftLoad(self.method, comps, self.data(g, depth), self.cutoff, self.position, g, depth)
+
+    def c_params(self):
+        """drift.c's record after the output: [method (0 mean, 1 newman, 2 qtf), cutoff (−1: none),
+        x, y, the data's c_params] (the wave numbers are drift.c's, from g and depth at
+        initialization)."""
+        from .physics.drift import METHODS
+        return ([float(METHODS.index(self.method)), self.cutoff if math.isfinite(self.cutoff) else -1.0]
+                + self.position.tolist() + self.data(9.81, math.inf).c_params())
 
 
 @dataclass
@@ -172,6 +222,7 @@ class LoadFMU:
     environment: Environment
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
     waves: Waves | None = None
+    drift: Drift | None = None
 
 
 @dataclass
@@ -210,6 +261,7 @@ class ConnectorFMU:
     a: Pose
     b: Pose | None
     environment: Environment
+    waves: Waves | None = None   # the scene's waves, for the node's drag and inertia (kinematics only)
 
 
 @dataclass

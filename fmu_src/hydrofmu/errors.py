@@ -23,3 +23,9 @@ class InputWarning(UserWarning):
         self.path, self.line, self.field, self.message = str(path), line, field, message
         where = self.path if line is None else f"{self.path}:{line}"
         super().__init__(f"{where}: {field}: {message}")
+
+
+def numbers(values, digits: int = 6) -> str:
+    """``[0, 0, -1]``: a vector as an error message prints it (plain numbers, ``digits`` significant
+    digits, no numpy reprs such as ``np.float64(-1.0)``)."""
+    return "[" + ", ".join(f"{float(v):.{digits}g}" for v in values) + "]"

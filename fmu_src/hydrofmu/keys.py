@@ -104,18 +104,22 @@ EFFECT_COMMON = {
 EFFECTS = {
     "aqwa_viscous_drag": {
         "deck": {"deck": (STRING, "AQWA input file, relative to the scene"),
-                 "body": (STRING, "FLOATING BODY name in the deck")},
+                 "body": (STRING, "FLOATING BODY name in the deck"),
+                 "waves": ({"type": "boolean"}, "our extension: the relative velocity also subtracts the incident waves' velocity")},
         "inline": {"matrix": (matrix(6), "6×6 drag matrix V (or 6 diagonal values), body axes"),
-                   "option": (enum("ABSOLUTE", "RELATIVE"), "RELATIVE: velocity relative to the current")},
+                   "option": (enum("ABSOLUTE", "RELATIVE"), "RELATIVE: velocity relative to the current"),
+                   "waves": ({"type": "boolean"}, "our extension: the relative velocity also subtracts the incident waves' velocity")},
     },
     "deeplines_current_polar": {
         "deck": {"deck": (STRING, "DeepLines data file, relative to the scene"),
                  "structure": (STRING, "*CURRENTPOL,NAME= of the structure"),
-                 "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+                 "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table"),
+                 "waves": ({"type": "boolean"}, "our extension: the current also subtracts the incident waves' velocity")},
         "inline": {"point": (vector(3), "current centre (XC, YC, ZC) [m], body axes"),
                    "surface": (POSITIVE, "reference surface SURFC [m2]"),
                    "table": (ROWS, "[[angle deg, CX, CY, CMZ m], …]"),
-                   "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table")},
+                   "symmetry": (enum("none", "xz", "yz", "xz+yz"), "symmetry completing the table"),
+                   "waves": ({"type": "boolean"}, "our extension: the current also subtracts the incident waves' velocity")},
     },
     "riflex_body": {
         "deck": {"offset": (vector(3), "attachment point [m], body axes from the reference point"), **COMPONENT},
@@ -138,6 +142,16 @@ EFFECTS["wave_excitation"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRIN
 EFFECTS["bem_hydrostatics"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "hydrostatics: Capytaine dataset "
                                                                                    "(.nc) or WAMIT .hst")}}
 
+EFFECTS["wave_drift"] = {"deck": {}, "inline": {
+    **BEM_EFFECT,
+    "bem": (STRING, "drift: WAMIT .7/.8/.9 (mean), .10d/.11d/.12d (QTF) or a Capytaine dataset with the "
+                    "far-field drift (hydrofmu meandrift)"),
+    "method": (enum("mean", "newman", "qtf"), "mean drift, Newman's approximation (default) or the full "
+                                              "difference-frequency QTF (WAMIT .10d/.11d/.12d)"),
+    "cutoff": (POSITIVE, "qtf: the largest |ω_i − ω_j| kept [rad/s] (default: every pair)"),
+    "period_variable": PERIOD_VARIABLE,
+}}
+
 WAVES = {
     "spectrum": (enum("regular", "jonswap", "pierson_moskowitz"), "sea state type (default jonswap)"),
     "hs": (NONNEG, "significant wave height Hs = 4·sqrt(m0) [m] (spectra)"),
@@ -152,7 +166,18 @@ WAVES = {
     "seed": ({"type": "integer", "minimum": 0}, "random seed of frequencies, phases, directions"),
     "ramp": (NONNEG, "length of the smooth start ramp [s] (default: 3 peak periods; 0: none)"),
     "depth": (POSITIVE, "water depth [m] (default: deep water)"),
+    "stretching": (enum("none", "vertical", "wheeler", "extrapolation"),
+                   "wave kinematics above the mean water level (default wheeler)"),
 }
+WAVE_POINT = {
+    "position": (vector(3), "a fixed point [m], global (outputs on the first body's load FMU)"),
+    "body": (STRING, "the body carrying the point (outputs on its load FMU)"),
+    "offset": (vector(3), "the point on the body [m], body axes from its reference point"),
+}
+WAVES["points"] = ({"type": "object", "additionalProperties": {
+    "type": "object", "additionalProperties": False,
+    "properties": {k: dict(v[0], description=v[1]) for k, v in WAVE_POINT.items()}}},
+    "named points whose wave kinematics are FMU outputs waves.<point>.*: [waves.points.NAME]")
 
 BODY = {
     "position": (vector(3), "initial (equilibrium) position of the reference point [m], global"),

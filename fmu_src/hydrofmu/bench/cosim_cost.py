@@ -48,13 +48,13 @@ def step_sweep(folder, steps=(0.2, 0.1, 0.05, 0.02, 0.01), algorithms=("jacobi",
     for _, case in table.iterrows():
         if case["status"] != "ok":
             raise RuntimeError(f"step sweep case {case['case']} failed: {case['error']}")
-        series, dt = read_series(out, case["case"]), case["run.step"]
-        result = Result(series["time"].to_numpy(), outputs, series[outputs].to_numpy(), case["run.algorithm"],
+        series, dt = read_series(out, case["case"]), case["step"]   # columns as the knobs were written
+        result = Result(series["time"].to_numpy(), outputs, series[outputs].to_numpy(), case["algorithm"],
                         dt, dynamics)
         if dt not in refs:
             refs[dt] = fleet.monolithic(result.time)
         err = nrms(fleet.displacements(result)[:, MOVING], refs[dt][:, MOVING]).max()
-        rows.append({"algorithm": case["run.algorithm"], "load_hold": case["run.load_hold"], "step": dt,
+        rows.append({"algorithm": case["algorithm"], "load_hold": case["run.load_hold"], "step": dt,
                      "error": float(err), "wall_s": float(case["wall_s"])})
     return pareto(rows)
 

@@ -22,10 +22,16 @@ Parts (each also callable alone, see ``PARTS``):
   instance pool (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
+- drift: the wave drift's cost per step per method (mean, newman, qtf with and without a
+  cut-off) against the first-order kernel at 50, 200, 1000 components, and Newman's error
+  against the full QTF (``drift_cost``)
 - waves: the `waves` effect's cost per step against the pythonfmu floor for 50, 200 and
   1000 components, and per 100 components (``waves_cost``); the floating cylinder's and the
   pair's motions in regular waves next to their lightly damped resonances, long runs at
   several steps, against the frequency domain (``waves_motions``)
+- kinematics: the shared wave phasors (the `waves` kernel per component per step, against cos/sin
+  every step) and the incident-wave kinematics per point per step against the `waves` kernel, at
+  50, 200, 1000 components, Python and compiled flavours (``kinematics_cost``)
 - ecco: libcosim's adaptive ECCO beside fixed-step Jacobi and Gauss–Seidel on the two-body
   case and every scene of models/: error, steps, wall time, energy residual; the step ECCO
   took against the bonds' power (``ecco_cost``)
@@ -537,6 +543,11 @@ def part_waves(out, quick):
         return [f"skipped: needs {waves_cost.DATA} (a repository checkout)"]
     write_csv(out / "waves.csv", rows)
     lines = waves_lines(rows)
+    from . import kinematics_cost   # the shared phasors: the kernel per component, both flavours
+    table = kinematics_cost.rows(kinematics_cost.python_costs(calls=300 if quick else 2000, rounds=2 if quick else 5),
+                                 kinematics_cost.compiled_costs(steps=2000 if quick else 20000,
+                                                                rounds=2 if quick else 5))
+    lines += [line for line in kinematics_cost.lines(table) if "kinematics per point" not in line]
     from . import waves_motions
     motions = waves_motions.measure(out / "waves_motions", quick)
     if motions:
@@ -544,6 +555,18 @@ def part_waves(out, quick):
         lines += ["motions in regular waves, radiation damping only, against X(ω) of the dataset (% of each dof's "
                   "peak |X|): " + line for line in waves_motions.summary(motions)]
     return lines
+
+
+def part_kinematics(out, quick):
+    """The wave phasors and the incident-wave kinematics per step, Python and compiled flavours."""
+    from . import kinematics_cost
+    python = kinematics_cost.python_costs(calls=300 if quick else 2000, rounds=2 if quick else 5)
+    compiled = kinematics_cost.compiled_costs(steps=2000 if quick else 20000, rounds=2 if quick else 5)
+    table = kinematics_cost.rows(python, compiled)
+    write_csv(out / "kinematics.csv", table)
+    clump = kinematics_cost.joined_barges_clump(out / "kinematics", stop=60.0 if quick else 200.0)
+    png = kinematics_cost.plot_clump(clump, out / "clump_in_waves.png")
+    return kinematics_cost.lines(table) + [f"the joined barges' clump with and without waves: {png.name}"]
 
 
 def waves_lines(rows):
@@ -569,10 +592,22 @@ def waves_lines(rows):
     return lines
 
 
+def part_drift(out, quick):
+    from . import drift_cost
+    counts = (50, 200) if quick else drift_cost.COUNTS
+    rows = drift_cost.cost(counts, rounds=2 if quick else 5)
+    crows = drift_cost.c_cost(counts, rounds=2 if quick else 5)
+    err = drift_cost.newman_error(hours=0.5 if quick else 2.0)
+    write_csv(out / "drift.csv", [{**r, **c} for r, c in zip(rows, crows)])
+    write_csv(out / "drift_newman.csv", [err])
+    return drift_cost.lines(rows, err, crows)
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "startup": part_startup, "stability": part_stability,
          "hold": part_hold,
-         "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves}
+         "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves,
+         "kinematics": part_kinematics, "drift": part_drift}
 
 
 # --quick without --part: the parts whose quick size costs under ~12 s of CPU each (measured

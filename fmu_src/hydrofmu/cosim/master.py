@@ -52,6 +52,7 @@ def run_settings(manifest, step=None, algorithm=None, stop=None):
             # the run's value replaces the scene's in the list too ("stop (run)", not "stop, stop (run)")
             out["set"] = [k for k in out["set"] if k != key] + [f"{key} (run)"]
     out["couplings"] = manifest.get("couplings", {})
+    out["flavour"] = manifest.get("flavour")   # 'python' or 'c': which FMUs ran
     if out["algorithm"] == "ecco":
         from ..scene import ECCO_DEFAULTS
         out["ecco"] = {**ECCO_DEFAULTS, **(cfg.get("ecco") or {})}
@@ -75,7 +76,9 @@ def describe(settings):
             f"{settings['load_hold']} load hold, substep {settings['substep']:g} s"
             + (f"; set by the scene/run: {', '.join(settings['set'])}" if settings["set"] else "")
             + (f"; chosen for the scene: {', '.join(settings['chosen'])}" if settings.get("chosen") else "")
-            + (f"; memory {memory}" if memory else ""))
+            + (f"; memory {memory}" if memory else "")
+            + {"python": "; Python flavour (pythonfmu FMUs)", "c": "; compiled flavour (C FMUs)"}.get(
+                settings.get("flavour"), ""))
 
 
 _descriptions = {}   # unzipped FMU folder (named by its content) -> its model description

@@ -128,42 +128,106 @@ def body_loads(result, manifest, body):
     return loads
 
 
-def _panel(ax, t, curves, title, colours, robust=True):
-    """Plot (effect, component, values) curves; limits from `robust_limits`."""
-    for effect, comp, y in curves:
-        ax.plot(t, y, color=colours.get(effect, "black"), ls=LINESTYLES[comp],
-                lw=2.0 if effect == TOTAL else 1.2)
+DOF_COLOURS = ("#1b9e77", "#d95f02", "#7570b3")   # motion panels: x / roll, y / pitch, z / yaw (not effect colours)
+ELEVATION = "0.45"                  # the wave elevation at the body, in the translation panel
+ROUND_OFF = 1e-9                    # a panel whose values are all below this share of its scale holds round-off only
+
+
+def time_axis(t):
+    """(times in the plot's unit, its label): seconds up to 15 minutes, minutes up to 3 hours,
+    then hours (a 30-minute record reads 0–30 min, not 0–1800 s)."""
+    t = np.asarray(t, float)
+    span = float(t[-1] - t[0]) if t.size else 0.0
+    if span > 3 * 3600:
+        return t / 3600, "time [h]"
+    if span > 900:
+        return t / 60, "time [min]"
+    return t, "time [s]"
+
+
+def round_off(curves, scale, floor=0.0):
+    """The largest |value| of ``curves`` [(effect, component, values)] when it is no more than
+    ``ROUND_OFF`` of ``scale`` (the largest value of the same kind on the body) or than
+    ``floor`` (an absolute bound), and not zero: the panel holds round-off only.  Else None."""
+    peak = max((float(np.nanmax(np.abs(y))) for _, _, y in curves if np.size(y)), default=0.0)
+    if not np.isfinite(peak) or peak == 0.0:
+        return None
+    return peak if peak <= max(ROUND_OFF * scale, floor) else None
+
+
+def _peak(curves):
+    return max((float(np.nanmax(np.abs(y))) for _, _, y in curves if np.size(y)), default=0.0)
+
+
+def _panel(ax, t, curves, title, colours, robust=True, scale=0.0, floor=0.0, unit="", legend=None):
+    """Plot (effect or colour, component, values) curves; limits from `robust_limits`.  A panel
+    of zeros says "zero throughout"; one whose values are round-off (`round_off` against
+    ``scale`` or ``floor``) says so with their size in ``unit`` instead of magnifying them.
+    ``legend``: labels of the curves, drawn in the panel."""
+    noise = round_off(curves, scale, floor)
+    lines = {}
+    # a legend's curves drawn widest first: the smaller ones stay on top (roll under pitch hid)
+    order = (sorted(range(len(curves)), key=lambda k: -float(np.nanmax(curves[k][2]) - np.nanmin(curves[k][2])))
+             if legend is not None and curves and all(np.size(y) for _, _, y in curves) else range(len(curves)))
+    for k in order:
+        effect, comp, y = curves[k]
+        lines[k], = ax.plot(t, y, color=colours.get(effect, effect if effect in DOF_COLOURS + (ELEVATION,) else "black"),
+                            ls=LINESTYLES[comp] if legend is None else "-",
+                            lw=2.0 if effect == TOTAL else 1.0 if legend is not None else 1.2,
+                            label=legend[k] if legend is not None else None)
     ax.grid(True, alpha=0.3)
-    if curves and all(np.all(np.asarray(y) == 0) for _, _, y in curves):
-        # nothing to see: say so instead of an empty ±1 axis
+    if curves and (noise is not None or all(np.all(np.asarray(y) == 0) for _, _, y in curves)):
+        # nothing to see: say so instead of an empty ±1 axis or magnified round-off
         ax.set_ylim(-1, 1)
         ax.set_yticks([0])
-        ax.text(0.5, 0.62, "zero throughout", transform=ax.transAxes, ha="center", va="center",
-                fontsize=9, color="0.35")
+        ax.text(0.5, 0.62, "zero throughout" if noise is None else
+                f"round-off only: |value| ≤ {noise:.2g}{' ' + unit if unit else ''}",
+                transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.35")
     elif curves and robust:
         lo, hi, clipped = robust_limits(t, [y for _, _, y in curves])
         ax.set_ylim(lo, hi)
         if clipped:   # in the title, where it covers no data and no tick label
             title += f"\naxis clipped to the settled run; data span {clipped[0]:.3g} … {clipped[1]:.3g}"
+    if legend is not None and curves:
+        ax.legend(handles=[lines[k] for k in range(len(curves))], fontsize=7, loc="upper right", ncol=len(curves),
+                  framealpha=0.7, handlelength=1.5)
     ax.set_title(title, fontsize=9)
+
+
+def wave_elevation(result, manifest, body):
+    """The wave elevation [m] at ``body``'s mean position (its load FMU's ``waves.elevation``),
+    or None when the scene has no waves acting on it."""
+    for name, inst in manifest["instances"].items():
+        if inst["kind"] == "load" and inst["body"] == body and f"{name}.waves.elevation" in result:
+            return result[f"{name}.waves.elevation"]
+    return None
+
+
+def flavour(manifest):
+    """'Python' or 'compiled': the FMUs' flavour a built folder holds (None when its manifest
+    predates the record)."""
+    return {"python": "Python", "c": "compiled"}.get((manifest or {}).get("flavour"))
 
 
 def plot(result, manifest, path):
     """Write a PNG of a run.
 
-    Per body two rows: translation from the initial pose [m], horizontal forces Fx, Fy
-    and vertical force Fz [kN]; rotation from the initial pose [deg], yaw moment Mz and
-    roll/pitch moments Mx, My [kN·m] (global axes, about the reference point).  Per joint
-    one row: gap [mm], relative rotation [deg], force on side A [kN].  Colour = effect
-    (the same in every panel, ``total`` black), line style = component (x solid, y
-    dashed, z dotted).
+    Per body two rows: translation from the initial pose [m] (x, y, z one colour each, with
+    the wave elevation at the body in grey when the scene has waves), horizontal forces Fx, Fy
+    and vertical force Fz [kN]; rotation from the initial pose [deg] (roll, pitch, yaw one
+    colour each), yaw moment Mz and roll/pitch moments Mx, My [kN·m] (global axes, about the
+    reference point).  Per joint one row: gap [mm], relative rotation [deg], force on side A
+    [kN].  In the load panels colour = effect (the same in every panel, ``total`` black) and
+    line style = component (x solid, y dashed, z dotted).  A panel of round-off (a moment of
+    1e-13 kN·m beside thousands) says so instead of magnifying it; the time axis is in
+    minutes past 15 minutes of record, in hours past 3 hours.
     """
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    t = result.time
+    t, time_label = time_axis(result.time)
     bodies = sorted(manifest["dynamics"])
     sides = joint_sides(manifest)
     loads = {b: body_loads(result, manifest, b) for b in bodies}
@@ -178,14 +242,26 @@ def plot(result, manifest, path):
         a0 = ", ".join(f"{v:.3g}" for v in np.degrees(att[0]))
         ld = loads[body]
         kn = lambda i: [(e, i % 3, v[:, i] / 1e3) for e, v in ld.items()]
-        _panel(axes[r, 0], t, [(None, i, dpos[:, i]) for i in range(3)],
-               f"{body}: translation x, y, z from ({x0}) m [m]", colours, robust=False)
-        _panel(axes[r, 1], t, kn(0) + kn(1), f"{body}: horizontal force Fx, Fy [kN]", colours)
-        _panel(axes[r, 2], t, kn(2), f"{body}: vertical force Fz [kN]", colours)
-        _panel(axes[r + 1, 0], t, [(None, i, np.degrees(datt[:, i])) for i in range(3)],
-               f"{body}: rotation roll, pitch, yaw from ({a0}) deg [deg; the CSV has rad]", colours, robust=False)
-        _panel(axes[r + 1, 1], t, kn(5), f"{body}: yaw moment Mz [kN·m]", colours)
-        _panel(axes[r + 1, 2], t, kn(3) + kn(4), f"{body}: roll, pitch moments Mx, My [kN·m]", colours)
+        forces, moments = kn(0) + kn(1) + kn(2), kn(3) + kn(4) + kn(5)
+        fscale, mscale = _peak(forces), _peak(moments)
+        move = [(DOF_COLOURS[i], i, dpos[:, i]) for i in range(3)]
+        labels = ["x", "y", "z"]
+        eta = wave_elevation(result, manifest, body)
+        if eta is not None:
+            move.append((ELEVATION, 0, np.asarray(eta, float)))
+            labels.append("η at the body")
+        _panel(axes[r, 0], t, move, f"{body}: translation from ({x0}) m"
+               + (" and wave elevation η" if eta is not None else "") + " [m]",
+               colours, robust=False, floor=1e-9, unit="m", legend=labels)
+        _panel(axes[r, 1], t, kn(0) + kn(1), f"{body}: horizontal force Fx, Fy [kN]", colours, scale=fscale,
+               unit="kN")
+        _panel(axes[r, 2], t, kn(2), f"{body}: vertical force Fz [kN]", colours, scale=fscale, unit="kN")
+        _panel(axes[r + 1, 0], t, [(DOF_COLOURS[i], i, np.degrees(datt[:, i])) for i in range(3)],
+               f"{body}: rotation from ({a0}) deg [deg; the CSV has rad]", colours, robust=False, floor=1e-9,
+               unit="deg", legend=["roll", "pitch", "yaw"])
+        _panel(axes[r + 1, 1], t, kn(5), f"{body}: yaw moment Mz [kN·m]", colours, scale=mscale, unit="kN·m")
+        _panel(axes[r + 1, 2], t, kn(3) + kn(4), f"{body}: roll, pitch moments Mx, My [kN·m]", colours,
+               scale=mscale, unit="kN·m")
         r += 2
     for joint, (a, b) in sorted(sides.items()):
         gap = result.vector(joint, "gap", 3) * 1e3
@@ -200,13 +276,15 @@ def plot(result, manifest, path):
                f"joint {joint}: force on {a} Fx, Fy, Fz [kN]", colours)
         r += 1
     for ax in axes[-1]:
-        ax.set_xlabel("time [s]")
+        ax.set_xlabel(time_label)
     handles = ([Line2D([], [], color=c, lw=2.0 if e == TOTAL else 1.2, label=e) for e, c in colours.items()]
                + [Line2D([], [], color="0.3", ls=ls, label=lab)
-                  for ls, lab in zip(LINESTYLES, ("x / Fx / Mx / roll", "y / Fy / My / pitch", "z / Fz / Mz / yaw"))])
+                  for ls, lab in zip(LINESTYLES, ("Fx / Mx", "Fy / My", "Fz / Mz"))])
     fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 8), fontsize=8, frameon=False,
                bbox_to_anchor=(0.5, 1 - 0.4 / fig.get_figheight()))
-    fig.suptitle(f"{manifest['scene']} ({result.algorithm}, step {result.step:g} s): loads on each body, "
+    kind = flavour(manifest)
+    fig.suptitle(f"{manifest['scene']} ({kind + ' flavour, ' if kind else ''}{result.algorithm}, "
+                 f"step {result.step:g} s): loads on each body, "
                  f"global axes, moments about its reference point", fontsize=11, y=1 - 0.1 / fig.get_figheight())
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.6 / fig.get_figheight()))
     fig.savefig(Path(path), dpi=100)

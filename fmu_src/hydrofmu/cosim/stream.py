@@ -108,6 +108,21 @@ class Sink:
                 part.unlink()
 
 
+def write_parquet(result, path, log=None) -> Path:
+    """An in-memory Result (a libcosim run) as the Parquet file a streamed run writes: the same
+    columns, units, manifest and settings in its metadata, written to ``.part`` and moved into
+    place (a fallback folder when ``path`` refuses it); returns the path written."""
+    sink = Sink(path)
+    sink.open(result.columns, result.units or {}, result.manifest, result.settings)
+    ok = False
+    try:
+        sink.write(result.time, result.values)
+        ok = True
+    finally:
+        sink.close(ok, log)
+    return sink.written[Path(path)]
+
+
 def _move(part, target):
     import shutil
     shutil.move(str(part), str(target))
@@ -238,7 +253,8 @@ class FileResult(Result):
         for a in acc.values():
             a["std"] = float(np.sqrt(a.pop("m2") / a.pop("n")))
             rows.append(a)
-        return Summary((self.manifest or {}).get("scene", ""), first or 0.0, last or 0.0, points, rows, notes)
+        return Summary((self.manifest or {}).get("scene", ""), first or 0.0, last or 0.0, points, rows, notes,
+                       (self.manifest or {}).get("flavour"))
 
     def plot(self, path) -> Path:
         """The PNG of ``cosim.report.plot`` drawn from every k-th row (at most ``PLOT_ROWS``).

@@ -18,6 +18,7 @@ MOTION = {"position": (("x", "y", "z"), ("m",) * 3),
           "attitude": (("roll", "pitch", "yaw"), ("rad",) * 3)}
 LOAD = (("Fx", "Fy", "Fz", "Mx", "My", "Mz"), ("N",) * 3 + ("N.m",) * 3)
 STATS = ("mean", "std", "min", "max")
+_FLAVOURS = {"python": "Python", "c": "compiled"}
 
 
 @dataclass
@@ -31,6 +32,7 @@ class Summary:
     points: int
     rows: list
     notes: list = field(default_factory=list)
+    flavour: str = None   # the FMUs that ran: 'python' or 'c' (None: not recorded)
 
     def to_dict(self) -> dict:
         """Nested: ``bodies[body][quantity][dof] = {unit, mean, std, min, max}``."""
@@ -38,7 +40,8 @@ class Summary:
         for r in self.rows:
             bodies.setdefault(r["body"], {}).setdefault(r["quantity"], {})[r["dof"]] = {
                 k: r[k] for k in ("unit",) + STATS}
-        return {"scene": self.scene, "from": self.start, "to": self.stop, "points": self.points,
+        return {"scene": self.scene, "flavour": _FLAVOURS.get(self.flavour), "from": self.start, "to": self.stop,
+                "points": self.points,
                 "statistics": "over the recorded points with from <= t <= to; std = population (1/n)",
                 "notes": self.notes, "bodies": bodies}
 
@@ -55,7 +58,9 @@ class Summary:
     def __str__(self):
         """The table: one line per body, quantity and dof that is not zero throughout (those
         are named in one line per body below the table)."""
-        head = (f"summary of {self.scene or 'the run'}, t = {self.start:g}–{self.stop:g} s ({self.points} points; "
+        kind = _FLAVOURS.get(self.flavour)
+        head = (f"summary of {self.scene or 'the run'}" + (f" ({kind} flavour)" if kind else "")
+                + f", t = {self.start:g}–{self.stop:g} s ({self.points} points; "
                 f"global axes, moments about each body's reference point, attitude in rad)")
         cells = [("body", "quantity", "dof", "unit") + STATS]
         zero = {}
@@ -120,4 +125,4 @@ def summarize(result, transient=0.0) -> Summary:
     notes = list(notes) + linear_range(result, manifest)
     t = result.time[keep]
     return Summary(manifest.get("scene", ""), float(t[0]) if t.size else 0.0, float(t[-1]) if t.size else 0.0,
-                   int(t.size), rows, notes)
+                   int(t.size), rows, notes, manifest.get("flavour"))

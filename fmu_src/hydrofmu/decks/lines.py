@@ -339,8 +339,9 @@ def fields(line, names, kind=float, defaults=None, slash=None):
     empty = _empty_field(line.text)
     if empty is not None and empty < len(names):
         raise line.error(names[empty], f"empty field between commas; expected {' '.join(names)}")
-    if len(words) > len(names):
-        raise line.error(names[-1], f"expected {len(names)} values ({' '.join(names)}), found {len(words)}")
+    if len(words) > len(names):   # named at the physical line of the first value too many
+        raise line.at_word(len(names)).error(names[-1], f"expected {len(names)} values ({' '.join(names)}), "
+                                                        f"found {len(words)}")
     values = {}
     for i, (name, typ) in enumerate(zip(names, kinds)):
         if i >= len(words):

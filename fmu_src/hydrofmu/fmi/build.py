@@ -266,12 +266,13 @@ def input_starts(slaves, conns):
     return out
 
 
-def manifest(scene, system, conns, inputs=None):
+def manifest(scene, system, conns, inputs=None, flavour="python"):
     """What our masters read (manifest.json): instances, routes, run settings, connections
     and the power bonds (fmi.osp.scalar_bonds); ``inputs``: the hash of the scene file, its
     decks and hydrofmu's sources the build came from (``api.inputs_hash``), when known."""
     return {"inputs": inputs,
         "scene": scene.name, "source": str(scene.path), "run": scene.run,
+        "flavour": flavour,   # the FMUs': 'python' (pythonfmu) or 'c' (compiled)
         "instances": {i.name: {"fmu": f"{i.model_id}.fmu", "kind": i.kind, "body": i.body}
                       for i in system.instances},
         "dynamics": {body: list(v) for body, v in system.dynamics.items()},
@@ -281,7 +282,8 @@ def manifest(scene, system, conns, inputs=None):
         "order": [i.name for i in system.instances],
         "connections": conns,
         "bonds": osp.scalar_bonds(osp.bonds(system)),
-        "warnings": list(scene.warnings),   # suspicious but legal input, as the build said it
+        "warnings": list(scene.warnings),   # suspicious but legal input, as the build said it (each once)
+        "warning_count": len(scene.warnings),
         "decks": [reading.as_dict() for reading in scene.decks],
     }
 
@@ -374,7 +376,8 @@ def _build_into(scene, outdir, target, system, runtime, shim, log, inputs=None):
         bonds = osp.bonds(system)
         result = work / "fmus"
         report_bem(scene, log, result)
-        (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns, inputs), indent=2))
+        (result / "manifest.json").write_text(json.dumps(manifest(scene, system, conns, inputs,
+                                                                     "c" if runtime is None else "python"), indent=2))
         for model_id, text in osp.model_descriptions(system, slaves, bonds).items():
             (result / f"{model_id}_OspModelDescription.xml").write_bytes(text)
         (result / "OspSystemStructure.xml").write_text(

@@ -12,6 +12,7 @@ compiler is installed, win64.
 """
 from __future__ import annotations
 
+import math
 import shutil
 import struct
 import tempfile
@@ -30,6 +31,7 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # the FMU's C sources, relative to the package (and to the FMU's sources/ folder)
 SOURCES = ["fmi/fmu.c", "fmi/models.c", "physics/kinematics.c", "physics/current.c", "physics/viscous_drag.c",
            "physics/current_polar.c", "physics/lumped.c", "physics/joint.c", "physics/memory.c", "physics/waves.c",
+           "physics/wave_kinematics.c", "physics/drift.c",
            "physics/hydrostatics.c", "physics/rigid.c"]
 HEADERS = ["fmi/fmu.h", "physics/kernels.h"]
 KINDS = {description.LoadFMU: 0, description.ConnectorFMU: 1, description.DynamicsFMU: 2}
@@ -75,6 +77,7 @@ def _env(slave):
 # the sea-state knobs in the order of the 'waves' record (models.c reads them in this order)
 SEA_KNOBS = ("height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp")
 SPECTRA = {"regular": 0, "jonswap": 1, "pierson_moskowitz": 2}
+from ..physics.waves import STRETCHING  # noqa: E402  (wave_kinematics.c's codes: their indices)
 
 
 def _waves(slave):
@@ -85,9 +88,16 @@ def _waves(slave):
     vr = {v.name: k for k, v in slave.vars.items()}
     sea = cfg.sea_state()
     knobs = [x for k in SEA_KNOBS for x in (slave.wave_knobs.get(k, -1), float(getattr(sea, k)))]
-    return [("waves", [vr[f"{name}.force[1]"], vr[f"{name}.elevation"], slave.g, SPECTRA[cfg.spectrum],
-                       float(sea.depth)] + knobs),
-            ("transfer", cfg.transfer(float(slave.values[slave.g]), sea.depth).c_params(cfg.window))]
+    window = tuple(cfg.window) if cfg.window else (0.0, math.inf)
+    transfer = cfg.transfer(float(slave.values[slave.g]), sea.depth)
+    recs = [("waves", [vr[f"{name}.force[1]"] if name else -1, vr[f"{name}.elevation"] if name else -1, slave.g,
+                       SPECTRA[cfg.spectrum], float(sea.depth)] + knobs),
+            ("transfer", transfer.c_params(window) if transfer is not None else list(window) + [0.0] * 5)]
+    if slave.kin_wanted:   # [stretching, feels, rho, npoints, (on_body, x, y, z, first output) per point]
+        points = [x for where, on_body, block in slave.points for x in (float(on_body), *where.tolist(), block.start)]
+        recs.append(("kinematics", [STRETCHING.index(sea.stretching), float(cfg.kinematics), slave.rho,
+                                    len(slave.points)] + points))
+    return recs
 
 
 def records(slave, desc) -> list[tuple[str, list[float]]]:
@@ -96,6 +106,9 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     if isinstance(desc, description.LoadFMU):
         if getattr(desc, "waves", None) is not None:
             recs += _waves(slave)
+        if getattr(desc, "drift", None) is not None:   # drift.c, on the components waves.c draws
+            vr = {v.name: k for k, v in slave.vars.items()}
+            recs.append(("drift", [vr[f"{desc.drift.name}.force[1]"]] + desc.drift.c_params()))
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]
         for e, out in zip(slave.loads.effects, slave.effect_force):
@@ -112,6 +125,8 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
                 ev = side.coupling.model().memory[side.side]
                 recs.append((ev.C_TAG, ev.c_params()))
     elif isinstance(desc, description.ConnectorFMU):
+        if desc.waves is not None:
+            recs += _waves(slave)
         recs += [("sides", _motion(slave.side_a) + (_motion(slave.side_b) if slave.side_b else [-1] * 4)),
                  *_env(slave), ("explicit", [slave.explicit]),
                  ("joint", slave.joint.c_params()), ("node", slave.joint.node.c_params()),

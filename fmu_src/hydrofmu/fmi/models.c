@@ -158,6 +158,145 @@ static int memory_load(Memory *m, const double *from, size_t n) {
     return m->kind == 1 ? hf_ss_load(&m->ss, from + 1, n - 1) : hf_conv_load(&m->cv, from + 1, n - 1);
 }
 
+/* -- the scene's waves in an FMU (ArraySlave._add_waves / _start_waves) ------------------ */
+
+typedef struct {
+    const double *waves, *transfer;   /* the 'waves' and 'transfer' records (NULL: no waves) */
+    const double *kinrec;             /* the 'kinematics' record (NULL: none) */
+    int nkinrec;
+    double *wave;                     /* waves.c's per-step parameters (NULL: not drawn yet) */
+    HfPhasors *phasors;               /* the FMU's one set of wave phasors */
+    double *kin;                      /* wave_kinematics.c's parameters (NULL: no kinematics) */
+    HfKinPoint *cache, **points;      /* the effects' scratch cache; one per named point */
+    HfWater water;
+    int feels, npoints, rho;          /* effects feel the water; points; rho's value reference */
+    const double *driftrec;           /* the 'drift' record after its output (NULL: no drift) */
+    int ndriftrec;
+    double *drift;                    /* drift.c's parameters (on the same components) */
+} Sea;
+
+static void sea_release(Sea *S) {
+    hf_phasors_delete(S->phasors), free(S->wave), free(S->kin), free(S->drift), hf_kin_point_delete(S->cache);
+    for (int k = 0; S->points && k < S->npoints; k++) hf_kin_point_delete(S->points[k]);
+    free(S->points);
+    S->phasors = NULL, S->wave = S->kin = S->drift = NULL, S->cache = NULL, S->points = NULL;
+}
+
+/* the 'waves', 'transfer' and 'kinematics' records; -1: of the wrong size */
+static int sea_setup(Instance *inst, Sea *S) {
+    const Record *w = hf_record(inst, "waves", NULL), *t = hf_record(inst, "transfer", NULL),
+                 *k = hf_record(inst, "kinematics", NULL), *d = hf_record(inst, "drift", NULL);
+    if (!w && !t && !k && !d) return 0;
+    if (d) {   /* [output, Drift.c_params] */
+        if (d->n < 2 || !hf_drift_record_ok(d->v + 1, (int)d->n - 1)) return -1;
+        S->driftrec = d->v + 1, S->ndriftrec = (int)d->n - 1;
+    }
+    if (!w || !t || w->n != 5 + 2 * SEA_KNOBS) return -1;
+    int nw = t->n >= 7 ? ivr(t->v[5]) : -1, nb = t->n >= 7 ? ivr(t->v[6]) : -1;
+    if (!((nw == 0 && nb == 0 && t->n == 7) || (nw >= 1 && nb >= 1 && t->n == 7 + nw + nb + 12 * nw * nb))) return -1;
+    S->waves = w->v, S->transfer = t->v;
+    if (k) {   /* [stretching, feels, rho, npoints, (on_body, x, y, z, out) per point] */
+        if (k->n < 4 || k->n != 4 + 5 * ivr(k->v[3])) return -1;
+        S->kinrec = k->v, S->nkinrec = (int)k->n, S->feels = k->v[1] != 0.0, S->rho = ivr(k->v[2]);
+        S->npoints = ivr(k->v[3]);
+    }
+    return 0;
+}
+
+/* the waves of the sea state the waves.* parameters (and g) hold now; -1: a knob that is not
+ * a usable sea state (logged naming it), or out of memory */
+static int sea_draw(Instance *inst, Sea *S) {
+    const double *w = S->waves, *v = inst->values;
+    double knob[SEA_KNOBS];
+    for (int k = 0; k < SEA_KNOBS; k++) knob[k] = w[5 + 2 * k] >= 0 ? v[ivr(w[5 + 2 * k])] : w[6 + 2 * k];
+    HfSea sea = {ivr(w[3]), knob[0], knob[1], knob[2], knob[3], knob[4], knob[5], knob[6], knob[7], knob[8], knob[9],
+                 knob[10], w[4]};
+    char field[16] = "", message[400] = "";
+    sea_release(S);
+    S->wave = hf_wave_build(&sea, S->transfer, v[ivr(w[2])], field, message, sizeof message);
+    if (!S->wave) {
+        hf_fail(inst, "waves.%s: %s", field, message);
+        return -1;
+    }
+    int n = (int)S->wave[0];
+    S->phasors = hf_wave_phasors(S->wave);
+    if (!S->phasors) goto oom;
+    if (S->driftrec) {   /* the body's wave drift on the same components (ArraySlave._start_waves) */
+        S->drift = hf_drift_build(S->wave, S->driftrec, S->ndriftrec, v[ivr(w[2])], w[4], field, message,
+                                  sizeof message);
+        if (!S->drift) {
+            sea_release(S);
+            hf_fail(inst, "waves.%s: %s", field, message);
+            return -1;
+        }
+    }
+    if (S->kinrec) {
+        const double *beta = S->wave + 2 + 3 * n + 14 * n;
+        S->kin = hf_kin_build(S->wave + 2, beta, n, v[ivr(w[2])], w[4], ivr(S->kinrec[0]));
+        S->cache = hf_kin_point_new(n);
+        S->points = calloc(S->npoints + 1, sizeof *S->points);
+        if (!S->kin || !S->cache || !S->points) goto oom;
+        for (int k = 0; k < S->npoints; k++)
+            if (!(S->points[k] = hf_kin_point_new(n))) goto oom;
+        S->water = (HfWater){S->kin, S->cache, NULL, 0.0, 0.0, w[4]};
+    }
+    return 0;
+oom:
+    sea_release(S);
+    hf_fail(inst, "out of memory for the wave kinematics");
+    return -1;
+}
+
+/* the phasors at t (one advance a step for the whole FMU) and the water the effects see;
+ * -1: the waves could not be drawn */
+static int sea_advance(Instance *inst, Sea *S, double t) {
+    if (!S->wave && sea_draw(inst, S)) {   /* (a state restored into an instance not started) */
+        hf_set_error(inst, "the waves.* parameters are not a usable sea state");
+        return -1;
+    }
+    const double *p = hf_phasors_at(S->phasors, t);
+    if (S->kin) S->water.p = p, S->water.r = hf_phasors_ramp(S->phasors), S->water.rho = inst->values[S->rho];
+    return 0;
+}
+
+/* the FMU state's part of the waves: [n, the phasors' state (n values; 0: not drawn)] */
+static size_t sea_state_size(const Sea *S) {
+    return S->waves ? 1 + (S->phasors ? hf_phasors_state_size(S->phasors) : 0) : 0;
+}
+
+static void sea_save(const Sea *S, double *to) {
+    if (!S->waves) return;
+    to[0] = S->phasors ? (double)hf_phasors_state_size(S->phasors) : 0.0;
+    if (S->phasors) hf_phasors_save(S->phasors, to + 1);
+}
+
+/* from [from, end): the waves' part (drawn first from the restored waves.* values when this
+ * instance has not drawn them); the values it used, or -1 */
+static long sea_load(Instance *inst, Sea *S, const double *from, const double *end) {
+    if (!S->waves) return 0;
+    if (from >= end) return -1;
+    size_t n = (size_t)from[0];
+    if (from + 1 + n > end) return -1;
+    if (n == 0) return 1;
+    if (!S->wave && sea_draw(inst, S)) return -1;
+    return hf_phasors_load(S->phasors, from + 1, n) ? -1 : (long)(1 + n);
+}
+
+/* the named points' outputs [u (3), a (3), p_d, elevation] (LoadSlave.evaluate) */
+static void sea_points(Instance *inst, Sea *S, const HfMotion *m) {
+    for (int k = 0; k < S->npoints; k++) {
+        const double *q = S->kinrec + 4 + 5 * k;
+        double x[3];
+        if (q[0] != 0.0) {   /* on the body: position + R offset */
+            hf_rotate(m->R, q + 1, x);
+            for (int i = 0; i < 3; i++) x[i] += m->position[i];
+        } else {
+            memcpy(x, q + 1, sizeof x);
+        }
+        hf_kin_at(S->kin, S->points[k], S->water.p, S->water.r, x, S->water.rho, inst->values + ivr(q[4]));
+    }
+}
+
 /* -- load FMU (LoadSlave) --------------------------------------------------------------- */
 
 enum { DRAG = 1, POLAR = 2, LUMPED = 3, HYDROSTATICS = 4 };
@@ -177,9 +316,9 @@ typedef struct {
     Side motion;
     int explicit_, total, effects_done;
     EnvRefs env;
-    const double *waves, *transfer;        /* the 'waves' and 'transfer' records (NULL: no waves) */
-    double *wave;                          /* waves.c's per-step parameters (NULL: not drawn yet) */
-    int wave_force, wave_elevation;
+    Sea sea;                               /* the scene's waves (sea.waves NULL: none) */
+    int wave_force, wave_elevation;        /* (-1: no excitation on this body) */
+    int drift_force;                       /* (-1: no wave drift) */
     Effect *effects;
     int neffects;
     Coupling *couplings;
@@ -191,7 +330,8 @@ static void load_release(Instance *inst) {
     if (!L) return;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) memory_free(&L->couplings[k].memory);
-    free(L->effects), free(L->couplings), free(L->wave), free(L);
+    sea_release(&L->sea);
+    free(L->effects), free(L->couplings), free(L);
     inst->data = NULL;
 }
 
@@ -214,16 +354,9 @@ static int load_setup(Instance *inst) {
         if (kind) {
             static const int sizes[] = {0, 38, -1, 13, 44};
             if (e->n < 2 || (sizes[kind] > 0 && e->n != sizes[kind]) ||
-                (kind == POLAR && e->n != 1 + 5 + (ivr(e->v[1]) + 2) * 4 + (ivr(e->v[1]) + 1) * 3))
+                (kind == POLAR && e->n != 1 + 5 + (ivr(e->v[1]) + 2) * 4 + (ivr(e->v[1]) + 1) * 3 + 1))
                 goto bad;
             L->effects[L->neffects++] = (Effect){kind, ivr(e->v[0]), e->v + 1};
-        } else if (strcmp(e->tag, "waves") == 0) {
-            if (e->n != 5 + 2 * SEA_KNOBS) goto bad;
-            L->wave_force = ivr(e->v[0]), L->wave_elevation = ivr(e->v[1]), L->waves = e->v;
-        } else if (strcmp(e->tag, "transfer") == 0) {
-            int nw = e->n > 7 ? ivr(e->v[5]) : 0, nb = e->n > 7 ? ivr(e->v[6]) : 0;
-            if (nw < 1 || nb < 1 || e->n != 7 + nw + nb + 12 * nw * nb) goto bad;
-            L->transfer = e->v;
         } else if (strcmp(e->tag, "coupling") == 0) {
             if (e->n != 3 + 36) goto bad;
             Coupling *c = &L->couplings[L->ncouplings++];
@@ -235,31 +368,19 @@ static int load_setup(Instance *inst) {
             if (memory_init(m)) goto bad;
         }
     }
-    if (!L->waves != !L->transfer) goto bad;
+    if (sea_setup(inst, &L->sea)) goto bad;
+    if (L->sea.waves) L->wave_force = ivr(L->sea.waves[0]), L->wave_elevation = ivr(L->sea.waves[1]);
+    L->drift_force = L->sea.driftrec ? ivr(L->sea.driftrec[-1]) : -1;
+    if (L->sea.driftrec && !L->sea.waves) goto bad;
     return 0;
 bad:
     hf_fail(inst, "model.bin: the load model's records are incomplete or of the wrong size");
     return -1;
 }
 
-/* the wave kernel of the sea state the waves.* parameters (and g) hold now (LoadSlave._start_waves);
- * -1: a knob that is not a usable sea state, logged naming it */
-static int draw_waves(Instance *inst, Load *L) {
-    const double *w = L->waves, *v = inst->values;
-    double knob[SEA_KNOBS];
-    for (int k = 0; k < SEA_KNOBS; k++) knob[k] = w[5 + 2 * k] >= 0 ? v[ivr(w[5 + 2 * k])] : w[6 + 2 * k];
-    HfSea sea = {ivr(w[3]), knob[0], knob[1], knob[2], knob[3], knob[4], knob[5], knob[6], knob[7], knob[8], knob[9],
-                 knob[10], w[4]};
-    char field[16] = "", message[400] = "";
-    free(L->wave);
-    L->wave = hf_wave_build(&sea, L->transfer, v[ivr(w[2])], field, message, sizeof message);
-    if (!L->wave) hf_fail(inst, "waves.%s: %s", field, message);
-    return L->wave ? 0 : -1;
-}
-
 static void load_start(Instance *inst) {   /* fresh memories (LoadSlave.start_physics) */
     Load *L = inst->data;
-    if (L->waves && draw_waves(inst, L)) return;
+    if (L->sea.waves && sea_draw(inst, &L->sea)) return;
     for (int k = 0; k < L->ncouplings; k++) {
         Memory *m = &L->couplings[k].memory;
         if (!m->kind) continue;
@@ -275,21 +396,25 @@ static void load_evaluate(Instance *inst) {
     Load *L = inst->data;
     /* the effects depend on the inputs and parameters only: after a step without a set
      * (a master reading the outputs) only the memories move */
-    int inputs_set = inst->changed || !L->effects_done;   /* (fmu.c has checked the inputs) */
+    int inputs_set = inst->changed || !L->effects_done || L->sea.feels;   /* (fmu.c has checked the inputs) */
     inst->changed = 0;
+    /* the waves first: the FMU's one advance of the phasors this step, then every effect reads them */
+    if (L->sea.waves && inst->running && sea_advance(inst, &L->sea, inst->has_next ? inst->next_time : 0.0)) return;
+    int wet = L->sea.feels && L->sea.phasors;
     /* (each load written straight into its outputs: a small array copied there just after
      * its scalar stores would stall the copy's loads) */
     double *v = inst->values, m6[36], extra[6];
     const HfMotion *m = NULL;
     const HfEnv *env = NULL;
-    if (inputs_set && L->neffects) m = motion_of(inst, &L->motion), env = env_now(inst, &L->env);
+    if ((inputs_set && L->neffects) || L->sea.npoints) m = motion_of(inst, &L->motion);
+    if (inputs_set && L->neffects) env = env_now(inst, &L->env), L->env.last.water = wet ? &L->sea.water : NULL;
     for (int k = 0; k < L->neffects && inputs_set; k++) {   /* BodyLoads.effect_loads */
         const Effect *e = &L->effects[k];
         double *out = v + e->out;
         if (e->kind == HYDROSTATICS) {
             hf_hydrostatics(e->params, m, out);
         } else if (e->kind == DRAG) {
-            hf_viscous_drag(e->params + 1, e->params[0] != 0.0, m, env, out);
+            hf_viscous_drag(e->params + 1, (int)e->params[0], m, env, out);   /* 0, 1, 2 (waves) */
         } else if (e->kind == POLAR) {
             hf_current_polar(e->params, m, env, out);
         } else {
@@ -315,23 +440,24 @@ static void load_evaluate(Instance *inst) {
         }
         if (c->acceleration >= 0) minus_product(out, c->mass, v + c->acceleration);
     }
-    if (L->waves && inst->running) {   /* a function of time only: the current communication point */
+    if (L->sea.waves && inst->running && L->wave_force >= 0) {   /* a function of time only */
         double w[7];
-        if (!L->wave && draw_waves(inst, L)) {   /* (a state restored into an instance not started) */
-            hf_set_error(inst, "the waves.* parameters are not a usable sea state");
-            return;
-        }
-        hf_waves(L->wave, inst->has_next ? inst->next_time : 0.0, w);
+        hf_waves(L->sea.wave, L->sea.phasors, inst->has_next ? inst->next_time : 0.0, w);
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }
+    if (L->sea.waves && inst->running && L->sea.drift)   /* on the phasors advanced above */
+        hf_drift(L->sea.drift, hf_phasors_at(L->sea.phasors, inst->has_next ? inst->next_time : 0.0),
+                 hf_phasors_ramp(L->sea.phasors), v + L->drift_force);
+    if (L->sea.waves && inst->running && L->sea.npoints) sea_points(inst, &L->sea, m);
     double *total = v + L->total;
     for (int i = 0; i < 6; i++) total[i] = 0.0;
     for (int k = 0; k < L->neffects; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->effects[k].out + i];
     for (int k = 0; k < L->ncouplings; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->couplings[k].out + i];
-    for (int i = 0; i < 6 && L->waves; i++) total[i] += v[L->wave_force + i];
+    for (int i = 0; i < 6 && L->sea.waves && L->wave_force >= 0; i++) total[i] += v[L->wave_force + i];
+    for (int i = 0; i < 6 && L->drift_force >= 0; i++) total[i] += v[L->drift_force + i];
 }
 
 static void load_step(Instance *inst, double t, double dt) {
@@ -342,7 +468,7 @@ static void load_step(Instance *inst, double t, double dt) {
         if (c->memory.kind && memory_commit(&c->memory, inst->values + c->velocity, dt))
             hf_set_error(inst, "out of memory in the retardation memory");
     }
-    if (L->ncouplings > 0 || L->waves) inst->stale = 1;   /* memory and wave outputs move with time */
+    if (L->ncouplings > 0 || L->sea.waves) inst->stale = 1;   /* memory and wave outputs move with time */
 }
 
 static size_t load_state_size(const Instance *inst) {
@@ -350,7 +476,7 @@ static size_t load_state_size(const Instance *inst) {
     size_t n = 0;
     for (int k = 0; k < L->ncouplings; k++)
         if (L->couplings[k].memory.kind) n += 1 + memory_size(&L->couplings[k].memory);
-    return n;
+    return n + sea_state_size(&L->sea);
 }
 
 static void load_save(const Instance *inst, double *to) {
@@ -363,6 +489,7 @@ static void load_save(const Instance *inst, double *to) {
         memory_save(m, to + 1);
         to += 1 + n;
     }
+    sea_save(&L->sea, to);
 }
 
 static int load_load(Instance *inst, const double *from, size_t size) {
@@ -376,7 +503,8 @@ static int load_load(Instance *inst, const double *from, size_t size) {
         if (from + 1 + n > end || n < 1 || memory_load(m, from + 1, n)) return -1;
         from += 1 + n;
     }
-    return from == end ? 0 : -1;
+    long used = sea_load(inst, &L->sea, from, end);
+    return used >= 0 && from + used == end ? 0 : -1;
 }
 
 const Model hf_load_model = {load_setup, load_start, load_evaluate, load_step, load_state_size, load_save, load_load,
@@ -389,10 +517,12 @@ typedef struct {
     int has_b, force_a, force_b, gap, rotation, explicit_;
     EnvRefs env;
     const double *joint, *node;
+    Sea sea;   /* the scene's waves: the node feels them */
 } Connector;
 
 static void connector_release(Instance *inst) {
     Connector *C = inst->data;
+    if (C) sea_release(&C->sea);
     free(C);
     inst->data = NULL;
 }
@@ -404,7 +534,7 @@ static int connector_setup(Instance *inst) {
                  *n = hf_record(inst, "node", NULL), *o = hf_record(inst, "outputs", NULL),
                  *x = hf_record(inst, "explicit", NULL);
     if (!C || !s || s->n != 8 || !j || j->n != 22 || !n || n->n != 12 || !o || o->n != 4 || !x ||
-        env_setup(inst, &C->env)) {
+        env_setup(inst, &C->env) || sea_setup(inst, &C->sea)) {
         hf_fail(inst, "model.bin: the connector model's records are incomplete or of the wrong size");
         return -1;
     }
@@ -415,13 +545,19 @@ static int connector_setup(Instance *inst) {
     return 0;
 }
 
-static void connector_start(Instance *inst) { inst->stale = 1; }
+static void connector_start(Instance *inst) {
+    Connector *C = inst->data;
+    if (C->sea.waves && sea_draw(inst, &C->sea)) return;
+    inst->stale = 1;
+}
 
 static void connector_evaluate(Instance *inst) {
     Connector *C = inst->data;   /* (fmu.c has checked the inputs) */
     double *v = inst->values, la[6], lb[6], gap[3], theta[3], node[6], m6[36];
     const HfMotion *a = motion_of(inst, &C->a), *b = C->has_b ? motion_of(inst, &C->b) : NULL;
+    if (C->sea.waves && inst->running && sea_advance(inst, &C->sea, inst->has_next ? inst->next_time : 0.0)) return;
     const HfEnv *env = env_now(inst, &C->env);
+    C->env.last.water = C->sea.feels && C->sea.phasors ? &C->sea.water : NULL;
     hf_joint(C->joint, a, b, la, lb, gap, theta);
     hf_lumped_load(C->node, a, env, node);   /* BallJoint: the node's loads on A */
     for (int i = 0; i < 6; i++) la[i] += node[i];
@@ -439,14 +575,24 @@ static void connector_evaluate(Instance *inst) {
     memcpy(v + C->rotation, theta, sizeof theta);
 }
 
-static void connector_step(Instance *inst, double t, double dt) { (void)inst, (void)t, (void)dt; }
+static void connector_step(Instance *inst, double t, double dt) {
+    (void)t, (void)dt;
+    if (((Connector *)inst->data)->sea.waves) inst->stale = 1;   /* the node's wave loads move with time */
+}
 static void nothing(Instance *inst) { (void)inst; }
 static size_t no_state_size(const Instance *inst) { (void)inst; return 0; }
 static void no_save(const Instance *inst, double *to) { (void)inst, (void)to; }
 static int no_load(Instance *inst, const double *from, size_t n) { (void)inst, (void)from; return n == 0 ? 0 : -1; }
 
+static size_t connector_state_size(const Instance *inst) { return sea_state_size(&((const Connector *)inst->data)->sea); }
+static void connector_save(const Instance *inst, double *to) { sea_save(&((const Connector *)inst->data)->sea, to); }
+static int connector_load(Instance *inst, const double *from, size_t n) {
+    long used = sea_load(inst, &((Connector *)inst->data)->sea, from, from + n);
+    return used >= 0 && (size_t)used == n ? 0 : -1;
+}
+
 const Model hf_connector_model = {connector_setup, connector_start, connector_evaluate, connector_step,
-                                  no_state_size, no_save, no_load, connector_release};
+                                  connector_state_size, connector_save, connector_load, connector_release};
 
 /* -- dynamics FMU (DynamicsSlave over rigid.c) -------------------------------------------- */
 

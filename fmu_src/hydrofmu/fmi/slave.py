@@ -70,7 +70,7 @@ from ..physics.memory import StateSpace
 from ..physics.rigid_body import CAPSIZE, LINEAR_RANGE, CoupledBodies, GimbalLockError, RigidBody
 from ..physics.current import CurrentProfile
 from ..physics.state import Env, Motion
-from ..physics.waves import WaveLoad, components as wave_components
+from ..physics.waves import Phasors, WaveLoad, components as wave_components
 
 # the sea-state knobs each spectrum exposes as waves.* parameters: (unit, description)
 WAVE_KNOBS = {
@@ -486,6 +486,69 @@ class ArraySlave(Fmi2Slave):
     def set_physics_state(self, state):
         pass
 
+    # the scene's waves (load and connector FMUs): the waves.* parameters, one Phasors a step
+
+    def _add_waves(self, cfg):
+        """The sea-state parameters waves.* (start values: the scene's), the excitation's
+        outputs <name>.force, <name>.elevation (with an excitation) and each named point's
+        waves.<point>.velocity, acceleration, pressure, elevation; returns [the force slice] or []."""
+        self.wave, self.wave_cfg, self.phasors, self.water, self.kin = None, cfg, None, None, None
+        self.points = []
+        self.kin_wanted = cfg is not None and (cfg.kinematics or bool(cfg.points))
+        if cfg is None:
+            return []
+        Par, Out = Fmi2Causality.parameter, Fmi2Causality.output
+        self.wave_knobs = {k: self.add(f"waves.{k}", Par, WAVE_KNOBS[k][0], cfg.sea[k], WAVE_KNOBS[k][1])
+                           for k in SPECTRUM_KNOBS[cfg.spectrum]}
+        for name, where in cfg.points.items():
+            on_body = "offset" in where
+            what = f"at point {name} ({'on the body' if on_body else 'fixed'})"
+            first = self.add_vector(f"waves.{name}.velocity", 3, Out, "m/s", None,
+                                    f"incident-wave particle velocity {what}, global axes")
+            self.add_vector(f"waves.{name}.acceleration", 3, Out, "m/s2", None,
+                            f"incident-wave particle acceleration (local, du/dt) {what}, global axes")
+            self.add(f"waves.{name}.pressure", Out, "Pa", 0.0, f"incident-wave dynamic pressure {what}")
+            self.add(f"waves.{name}.elevation", Out, "m", 0.0, f"incident-wave elevation above point {name}")
+            block = slice(first.start, first.start + 8)
+            self.points.append((np.asarray(where.get("offset", where.get("position")), float), on_body, block))
+            self.depends([block], self.motion_inputs[:2] if on_body else [])
+        if cfg.name is None:
+            return []
+        force = self.add_vector(f"{cfg.name}.force", 6, Out, LIN_ROT["force"], None,
+                                "first-order wave excitation, global axes, about the reference point")
+        self.elevation = self.add(f"{cfg.name}.elevation", Out, "m", 0.0,
+                                  "wave elevation at the reference point's mean position")
+        self.depends([force, slice(self.elevation, self.elevation + 1)], [])
+        return [force]
+
+    def _start_waves(self):
+        """The phasors, excitation and kinematics of the sea state the waves.* parameters hold
+        now (one error naming the knob when they are not a usable sea state)."""
+        from ..physics.wave_kinematics import Water, WaveKinematics
+        cfg = self.wave_cfg
+        knobs = {k: float(self.values[vr]) for k, vr in self.wave_knobs.items()}
+        for k in ("components", "seed"):
+            if k in knobs and knobs[k] == int(knobs[k]):
+                knobs[k] = int(knobs[k])
+        sea = cfg.sea_state(**knobs)
+        g = float(self.values[self.g])
+        try:
+            sea.check()
+            comps = wave_components(sea, tuple(cfg.window) if cfg.window else (0.0, math.inf))
+            self.phasors = Phasors(comps, sea.ramp)
+            transfer = cfg.transfer(g, sea.depth)
+            self.wave = None if transfer is None else WaveLoad(comps, transfer, cfg.position, sea.ramp, g, sea.depth,
+                                                               phasors=self.phasors)
+            # the points and the effects each their own kernel: each keeps the factors of its last points
+            self.kin = WaveKinematics(comps, g, sea.depth, sea.stretching) if self.points else None
+            self.water = (Water(WaveKinematics(comps, g, sea.depth, sea.stretching), self.phasors,
+                                float(self.values[self.rho])) if cfg.kinematics else None)
+            drift = getattr(self, "drift_cfg", None)   # a load FMU's wave drift: the same components
+            self.drift = drift.kernel(comps, g, sea.depth) if drift is not None else None
+        except ValueError as exc:
+            self.phasors = self.wave = self.water = self.kin = self.drift = None
+            raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
+
 
 class LoadSlave(ArraySlave):
     """Loads on one floating body: motion in, force out (global axes, about the
@@ -523,6 +586,8 @@ class LoadSlave(ArraySlave):
         self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
         wave_force = self._add_waves(cfg.waves)
+        self._wave_row = int(bool(wave_force))   # the output block's rows after the couplings: the excitation,
+        wave_force = wave_force + self._add_drift(getattr(cfg, "drift", None))   # then the drift
         # every load output in one block: total, each effect, each coupling, the waves
         self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
                                      + wave_force)]
@@ -541,38 +606,16 @@ class LoadSlave(ArraySlave):
         self.memories = []   # set up by start_physics
         self.stale = True
 
-    def _add_waves(self, cfg):
-        """The sea-state parameters waves.* (start values: the scene's) and the outputs
-        <name>.force, <name>.elevation; returns [the force slice] or [] without waves."""
-        self.wave, self.wave_cfg = None, cfg
+    def _add_drift(self, cfg):
+        """The output <name>.force of the body's wave drift (on the waves' sea state and
+        phasors); returns [the force slice] or []."""
+        self.drift, self.drift_cfg = None, cfg
         if cfg is None:
             return []
-        Par, Out = Fmi2Causality.parameter, Fmi2Causality.output
-        self.wave_knobs = {k: self.add(f"waves.{k}", Par, WAVE_KNOBS[k][0], cfg.sea[k], WAVE_KNOBS[k][1])
-                           for k in SPECTRUM_KNOBS[cfg.spectrum]}
-        force = self.add_vector(f"{cfg.name}.force", 6, Out, LIN_ROT["force"], None,
-                                "first-order wave excitation, global axes, about the reference point")
-        self.elevation = self.add(f"{cfg.name}.elevation", Out, "m", 0.0,
-                                  "wave elevation at the reference point's mean position")
-        self.depends([force, slice(self.elevation, self.elevation + 1)], [])
+        force = self.add_vector(f"{cfg.name}.force", 6, Fmi2Causality.output, LIN_ROT["force"], None,
+                                f"second-order wave drift ({cfg.method}), global axes, about the reference point")
+        self.depends([force], [])
         return [force]
-
-    def _start_waves(self):
-        """The wave kernel of the sea state the waves.* parameters hold now (one error naming
-        the knob when they are not a usable sea state)."""
-        cfg = self.wave_cfg
-        knobs = {k: float(self.values[vr]) for k, vr in self.wave_knobs.items()}
-        for k in ("components", "seed"):
-            if k in knobs and knobs[k] == int(knobs[k]):
-                knobs[k] = int(knobs[k])
-        sea = cfg.sea_state(**knobs)
-        g = float(self.values[self.g])
-        try:
-            sea.check()
-            comps = wave_components(sea, tuple(cfg.window))
-            self.wave = WaveLoad(comps, cfg.transfer(g, sea.depth), cfg.position, sea.ramp, g, sea.depth)
-        except ValueError as exc:
-            raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 
     def start_physics(self):
         """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
@@ -602,7 +645,7 @@ class LoadSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
-        if self.wave_cfg is not None and self.wave is None and self.running:
+        if self.wave_cfg is not None and self.phasors is None and self.running:
             try:   # (initialization failed on the sea state: no step goes on without its waves)
                 self._start_waves()
             except ValueError as exc:
@@ -610,17 +653,31 @@ class LoadSlave(ArraySlave):
                 return
         v = self.values
         ne = len(self.loads.effects)
-        out = np.zeros((1 + ne + len(self.couplings) + (self.wave_cfg is not None), 6))   # total, effects, couplings, waves
+        nd = self.drift_cfg is not None
+        out = np.zeros((1 + ne + len(self.couplings) + self._wave_row + nd, 6))   # total, effects, couplings, waves, drift
+        if self.phasors is not None:   # the FMU's one advance of the wave phasors this step
+            p = self.phasors.at(self.next_time or 0.0)
         if ne:
-            self.loads.effect_loads(self.motion(self.motion_inputs), self.env(), out[1:1 + ne])
+            env = self.env()
+            env.water = self.water
+            self.loads.effect_loads(self.motion(self.motion_inputs), env, out[1:1 + ne])
         for mem, vel, rows in self.memories:
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
             out[k] -= mass.dot(v[acc])
-        if self.wave is not None:   # the last row: a function of time only
+        if self.wave is not None:   # a function of time only
             w = self.wave(self.next_time or 0.0)
-            out[-1] = w[:6]
+            out[1 + ne + len(self.couplings)] = w[:6]
             v[self.elevation] = w[6]
+        if self.drift is not None:   # the last row: quadratic in the ramped phasors r·p
+            r = self.phasors.ramp_factor
+            out[-1] = self.drift(p) * (r * r)
+        if self.points and self.kin is not None:
+            m = self.motion(self.motion_inputs) if any(b for _, b, _ in self.points) else None
+            where = [m.position + m.rot @ x if on_body else x for x, on_body, _ in self.points]
+            rows = self.kin.at(p, self.phasors.ramp_factor, where, float(v[self.rho]))
+            for (_, _, block), row in zip(self.points, rows):
+                v[block] = row
         out[0] = self._load_total.dot(out)   # (ndarray.dot: half the call cost of @ here)
         v[self._load_out] = out.ravel()
         # the total sums every other output: if it is finite, so are they (an overflow of the
@@ -631,14 +688,17 @@ class LoadSlave(ArraySlave):
         # not stale: the inputs are those of the last evaluation, whose peek the step takes
         for mem, vel, _ in self.memories:
             mem.commit(self.values[vel], dt, peeked=not self.stale)
-        self.stale = bool(self.couplings) or self.wave is not None  # memory and wave outputs move with time
+        self.stale = bool(self.couplings) or self.phasors is not None  # memory and wave outputs move with time
 
     def physics_state(self):
-        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.wave is not None}
+        return {"memory": [mem.state() for mem, _, _ in self.memories], "waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
 
     def set_physics_state(self, state):
-        if state.get("waves") and self.wave is None:   # taken after initialization, restored before it
+        if state.get("waves") and self.phasors is None:   # taken after initialization, restored before it
             self._start_waves()
+        if state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
         saved = state["memory"]
         if len(saved) != len(self.memories):   # taken after initialization and restored before it, or back
             if saved:
@@ -814,6 +874,8 @@ class ConnectorSlave(ArraySlave):
         self.side_b = (self.add_motion("B.", cfg.b, False, "side B")
                        if cfg.b is not None else None)
         inputs = self.side_a + (self.side_b or []) + self.add_environment(self.joint.uses_current)
+        self.motion_inputs = self.side_a
+        self._add_waves(cfg.waves)   # the node feels the waves (no outputs of their own)
         self.force_a = self.add_vector("A.force", 6, Out, LIN_ROT["force"], None,
                                        "load on side A, global axes, about A's reference point")
         self.force_b = self.add_vector("B.force", 6, Out, LIN_ROT["force"], None,
@@ -834,9 +896,19 @@ class ConnectorSlave(ArraySlave):
             if not self.check_finite(self.inputs):
                 return
             self.suspect = False
+        if self.wave_cfg is not None and self.phasors is None and self.running:
+            try:   # (initialization failed on the sea state: no step goes on without its waves)
+                self._start_waves()
+            except ValueError as exc:
+                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
+                return
+        env = self.env()
+        if self.phasors is not None:
+            self.phasors.at(self.next_time or 0.0)
+            env.water = self.water
         a = self.motion(self.side_a)
         b = self.motion(self.side_b) if self.side_b else None
-        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, self.env())
+        load_a, load_b, gap, rotation = self.joint.loads_and_deformation(a, b, env)
         if self.joint.uses_acceleration:
             if self.explicit:
                 load_a = load_a - self.joint.mass_matrix(a).dot(a.acceleration)
@@ -844,6 +916,24 @@ class ConnectorSlave(ArraySlave):
         v = self.values
         v[self.force_a], v[self.force_b] = load_a, load_b
         v[self.gap], v[self.rotation] = gap, rotation
+
+    def start_physics(self):
+        if self.wave_cfg is not None:
+            self._start_waves()
+        self.stale = True
+
+    def step_physics(self, t, dt):
+        self.stale = self.phasors is not None   # the node's wave loads move with time
+
+    def physics_state(self):
+        return {"waves": self.phasors is not None,
+                "phasors": self.phasors.state() if self.phasors is not None else None}
+
+    def set_physics_state(self, state):
+        if state and state.get("waves") and self.phasors is None:
+            self._start_waves()
+        if state and state.get("phasors") and self.phasors is not None:
+            self.phasors.set_state(state["phasors"])
 
 
 class FeedthroughMemory:

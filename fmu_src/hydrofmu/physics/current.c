@@ -19,6 +19,7 @@ static double interp(double x, const double *xs, const double *ys, int n) {
 
 void hf_env(HfEnv *env, double rho, double g, double speed, double direction, const HfProfile *profile) {
     env->rho = rho, env->g = g, env->speed = speed, env->direction = direction, env->profile = profile;
+    env->water = NULL;
     hf_current_components(speed, direction, env->uniform);
 }
 

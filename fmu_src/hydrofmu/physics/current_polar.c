@@ -22,6 +22,10 @@ void hf_current_polar(const double *params, const HfMotion *m, const HfEnv *env,
     double r[3], c[3], p[3] = {xc, yc, zc};
     hf_rotate(R, p, r);
     hf_current_at(env, m->position[2] + r[2], c);
+    if (slope[3 * (n + 1)] != 0.0 && env->water) {   /* waves = true: the waves' velocity at P too */
+        double x[3] = {m->position[0] + r[0], m->position[1] + r[1], m->position[2] + r[2]}, row[8];
+        if (hf_water_at(env->water, x, row)) c[0] += row[0], c[1] += row[1], c[2] += row[2];
+    }
     double ux = c[0] - (vel[0] + vel[4] * r[2] - vel[5] * r[1]);
     double uy = c[1] - (vel[1] + vel[5] * r[0] - vel[3] * r[2]);
     double uz = c[2] - (vel[2] + vel[3] * r[1] - vel[4] * r[0]);

@@ -12,6 +12,10 @@ Load (all in body axes unless said otherwise):
     F_body = q·(CXC(α), CYC(α), 0),  M_body = (0, 0, q·CMZC(α))     at P
     load = [R·F_body ; r × R·F_body + R·M_body]   global, about the reference point
 
+Our extension (``waves = true``; DeepLines' polar sees the current alone): u_c also holds the
+incident-wave particle velocity at P's instantaneous position (physics/wave_kinematics.py),
+none when P is above the instantaneous surface.
+
 CXC, CYC are dimensionless, CMZC has the unit m (the formula has no reference length).
 Coefficients interpolate linearly in α with wrap-around (359° → 0°).
 
@@ -164,6 +168,7 @@ class CurrentPolar:
     yc: float
     zc: float
     surfc: float
+    waves: bool = False   # our extension: u_c also holds the incident waves' velocity at P (env.water)
     uses_current: ClassVar[bool] = True
     uses_acceleration: ClassVar[bool] = False
 
@@ -204,7 +209,12 @@ class CurrentPolar:
         px, py, pz = self.xc, self.yc, self.zc
         rx, ry, rz = r00 * px + r01 * py + r02 * pz, r10 * px + r11 * py + r12 * pz, r20 * px + r21 * py + r22 * pz
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
-        cx, cy, cz = env.current_xyz(float(motion.position[2]) + rz)   # current at P
+        ox, oy, oz = motion.position.tolist()
+        cx, cy, cz = env.current_xyz(oz + rz)   # current at P
+        if self.waves and env.water is not None:   # our extension: the waves' velocity at P too
+            row = env.water.at(ox + rx, oy + ry, oz + rz)
+            if env.water.wet(row, oz + rz):
+                cx, cy, cz = cx + row[0], cy + row[1], cz + row[2]
         ux, uy, uz = cx - (vx + wy * rz - wz * ry), cy - (vy + wz * rx - wx * rz), cz - (vz + wx * ry - wy * rx)
         bx, by = r00 * ux + r10 * uy + r20 * uz, r01 * ux + r11 * uy + r21 * uz   # body axes
         v2 = bx * bx + by * by
@@ -225,6 +235,6 @@ class CurrentPolar:
 
     def c_params(self):
         """current_polar.c's parameters: [n, xc, yc, zc, surfc, the closed table's angles
-        (n + 2), coefficients ((n + 2)·3) and slopes ((n + 1)·3)]."""
+        (n + 2), coefficients ((n + 2)·3), slopes ((n + 1)·3), waves (0/1)]."""
         return ([float(len(self.angles)), self.xc, self.yc, self.zc, self.surfc]
-                + self._a.tolist() + self._c.ravel().tolist() + self._slope.ravel().tolist())
+                + self._a.tolist() + self._c.ravel().tolist() + self._slope.ravel().tolist() + [float(self.waves)])

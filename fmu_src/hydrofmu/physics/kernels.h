@@ -23,12 +23,23 @@ typedef struct {
     const double *z, *ratio, *turn;
 } HfProfile;
 
+/* the incident waves the effects of an FMU see at this step (wave_kinematics.py Water):
+ * hf_kin_build's params, a scratch cache, the phasors at this step, ramp r, rho, depth */
+typedef struct HfKinPoint HfKinPoint;
+typedef struct {
+    const double *kin;
+    HfKinPoint *cache;
+    const double *p;
+    double r, rho, depth;
+} HfWater;
+
 /* physics/state.py Env: density, gravity, surface current, its profile (NULL: uniform);
- * uniform: the current's components (hf_env sets them) */
+ * uniform: the current's components (hf_env sets them); water: the incident waves (NULL: still) */
 typedef struct {
     double rho, g, speed, direction;
     const HfProfile *profile;
     double uniform[3];
+    const HfWater *water;
 } HfEnv;
 
 /* kinematics.c */
@@ -59,10 +70,10 @@ void hf_current_components(double speed, double direction_deg, double *out);
 void hf_env(HfEnv *env, double rho, double g, double speed, double direction, const HfProfile *profile);
 void hf_current_at(const HfEnv *env, double z, double *out);
 
-/* viscous_drag.c: matrix 36 (body axes, row-major), relative 0/1 */
+/* viscous_drag.c: matrix 36 (body axes, row-major), relative 0 (ABSOLUTE), 1 (RELATIVE), 2 (RELATIVE with waves) */
 void hf_viscous_drag(const double *matrix, int relative, const HfMotion *m, const HfEnv *env, double *out);
 
-/* current_polar.c: params [n, xc, yc, zc, surfc, angles (n+2), coef ((n+2)*3), slope ((n+1)*3)] */
+/* current_polar.c: params [n, xc, yc, zc, surfc, angles (n+2), coef ((n+2)*3), slope ((n+1)*3), waves (0/1)] */
 void hf_current_polar(const double *params, const HfMotion *m, const HfEnv *env, double *out);
 
 /* waves.c: a sea state (physics.waves.SeaState; spectrum 0 regular, 1 jonswap, 2 pierson_moskowitz) */
@@ -73,12 +84,60 @@ typedef struct {
 /* 0, or -1 with the bad knob's name in field (16 chars) and why in message */
 int hf_sea_check(const HfSea *sea, char *field, char *message, size_t size);
 double hf_wave_number(double omega, double g, double depth);
-/* the per-step parameters [n, ramp length, omega (n), table (2n x 7)] (malloc'd; NULL: field and
- * message say why) of a sea state and a transfer function [window_lo, window_hi, x, y, closed, nw,
- * nb, omega (nw), directions (nb), re (nw nb 6), im (nw nb 6)] (TransferFunction.c_params) */
+/* the per-step parameters [n, ramp length, omega (n), a e^{i phi} (n (re, im) pairs), table (2n x 7),
+ * direction (n, deg)] (malloc'd; NULL: field and message say why) of a sea state and a transfer
+ * function [window_lo, window_hi, x, y, closed, nw, nb, omega (nw), directions (nb), re (nw nb 6),
+ * im (nw nb 6)] (TransferFunction.c_params; nw = nb = 0: no excitation, the window alone) */
 double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *field, char *message, size_t size);
-/* out: [F (6), elevation] at time t */
-void hf_waves(const double *params, double t, double *out);
+/* The shared per-step phasors (waves.Phasors): p (n (re, im) pairs) = a_k e^{i(w_k t + phi_k)} at
+ * time t, advanced by one complex multiply per component per step, exact every HF_RESYNC steps
+ * and off the step grid; one per FMU, every wave effect reads it. */
+#define HF_RESYNC 1024     /* waves.RESYNC */
+#define HF_GRID_ULPS 4     /* waves.GRID_ULPS */
+typedef struct {
+    int n, resync, j, has_rot;
+    double ramp, t, sync, h;
+    const double *omega, *amp;   /* (not owned) */
+    double *p, *rot;
+    long exact, rotations;
+} HfPhasors;
+HfPhasors *hf_phasors_new(const double *omega, const double *amp, int n, double ramp, int resync);
+void hf_phasors_delete(HfPhasors *P);
+const double *hf_phasors_at(HfPhasors *P, double t);
+double hf_phasors_ramp(const HfPhasors *P);   /* r(t) at the phasors' time */
+size_t hf_phasors_state_size(const HfPhasors *P);
+void hf_phasors_save(const HfPhasors *P, double *to);
+int hf_phasors_load(HfPhasors *P, const double *from, size_t n);
+/* the phasors of hf_wave_build's parameters (which they point into) */
+HfPhasors *hf_wave_phasors(const double *params);
+/* out: [F (6), elevation] at time t (advances P to t) */
+void hf_waves(const double *params, HfPhasors *P, double t, double *out);
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac);
+
+/* drift.c: the wave drift of a body on the components of hf_wave_build's parameters
+ * (physics.drift.DriftLoad), the record from Drift.c_params; per step from the shared phasors
+ * p (n (re, im) pairs, un-ramped) and the ramp r: out (6) */
+double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
+                       char *message, size_t size);
+void hf_drift(const double *params, const double *p, double r, double *out);
+int hf_drift_record_ok(const double *record, int n);
+
+/* wave_kinematics.c: Airy kinematics of the components at a point.  params [n, g, depth,
+ * stretching (0 none, 1 vertical, 2 wheeler, 3 extrapolation), omega (n), k (n), cos beta (n),
+ * sin beta (n)] (malloc'd by hf_kin_build); a point's cache of its factors (one per point);
+ * out [u (3), a (3), dynamic pressure, elevation] at x (3, global) from the phasors p and ramp r */
+#define HF_STRETCHING {"none", "vertical", "wheeler", "extrapolation"}
+struct HfKinPoint {
+    double x, y, z;
+    double *e, *fh, *fv, *fp;
+};
+/* row (8) of the water at x (3, global); 1 if x is wet (below the instantaneous surface, above the bed) */
+int hf_water_at(const HfWater *w, const double *x, double *row);
+double *hf_kin_build(const double *omega, const double *direction_deg, int n, double g, double depth, int stretching);
+HfKinPoint *hf_kin_point_new(int n);
+void hf_kin_point_delete(HfKinPoint *c);
+void hf_kin_at(const double *params, HfKinPoint *c, const double *p, double r, const double *x, double rho,
+               double *out);
 
 /* hydrostatics.c: params [C (36, row-major), position0 (3), yaw0, vertical0 (3)]: F = -C delta */
 void hf_hydrostatics(const double *params, const HfMotion *m, double *out);

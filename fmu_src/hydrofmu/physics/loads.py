@@ -23,12 +23,12 @@ from .viscous_drag import ViscousDrag
 
 
 def _viscous_drag(name, d):
-    return ViscousDrag(name, np.asarray(d["matrix"], dtype=float), bool(d["relative"]))
+    return ViscousDrag(name, np.asarray(d["matrix"], dtype=float), bool(d["relative"]), bool(d.get("waves", False)))
 
 
 def _current_polar(name, d):
     return CurrentPolar(name, *(np.asarray(d[k], dtype=float) for k in ("angles", "cx", "cy", "cmz")),
-                        *d["point"], d["surface"])
+                        *d["point"], d["surface"], bool(d.get("waves", False)))
 
 
 def _lumped(name, d):

@@ -1,5 +1,7 @@
 /* RIFLEX BODY (physics/lumped.py LumpedBody): weight, buoyancy and quadratic drag at a
- * point of the body; its mass matrix and centripetal load.
+ * point of the body (in waves: drag on current + waves - point, and the water's acceleration
+ * loads rho AE a_w + added mass a_w, none when the point is dry); its mass matrix and
+ * centripetal load.
  * params [offset (3), am, ae, local (0/1), cd (3), added (3)] */
 #include <math.h>
 #include <string.h>
@@ -24,12 +26,23 @@ static void per_axis(const double *p, const HfMotion *m, const double *coef, int
 }
 
 void hf_lumped_load(const double *p, const HfMotion *m, const HfEnv *env, double *out) {
-    double r[3], w[3], c[3], u[3], f[3];
+    double r[3], w[3], c[3], u[3], f[3], g[3] = {0, 0, 0};
     hf_rotate(m->R, p, r);
     hf_cross(m->velocity + 3, r, w);
     hf_current_at(env, m->position[2] + r[2], c);
+    if (env->water) {   /* in waves: at the point's instantaneous position (LumpedBody.load) */
+        double x[3] = {m->position[0] + r[0], m->position[1] + r[1], m->position[2] + r[2]}, row[8], am[3];
+        if (hf_water_at(env->water, x, row)) {
+            for (int i = 0; i < 3; i++) c[i] += row[i];
+            per_axis(p, m, p + 9, 0, row + 3, am);
+            for (int i = 0; i < 3; i++) g[i] = env->rho * p[4] * row[3 + i] + am[i];
+        } else {   /* dry: no drag */
+            for (int i = 0; i < 3; i++) c[i] = m->velocity[i] + w[i];
+        }
+    }
     for (int i = 0; i < 3; i++) u[i] = c[i] - (m->velocity[i] + w[i]);
     per_axis(p, m, p + 6, 1, u, f);
+    for (int i = 0; i < 3; i++) f[i] += g[i];
     f[2] += env->rho * env->g * p[4] - p[3] * env->g;
     out[0] = f[0], out[1] = f[1], out[2] = f[2];
     hf_cross(r, f, out + 3);

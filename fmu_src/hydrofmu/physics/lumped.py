@@ -28,7 +28,20 @@ transferred to the reference point this splits into
     ``velocity_load`` = transfer(−M_p·(ω × (ω × R·r)), R·r)   (centripetal, velocity only)
 
 so the exact total acceleration load is −M6·acceleration + velocity_load.  The added
-mass uses the Morison form −A·a_p (uniform steady current: no water acceleration).
+mass uses the Morison form −A·a_p.
+
+In waves (``env.water``, the scene's incident wave field, physics/wave_kinematics.py) the point
+feels the water's motion at its instantaneous position P, the Morison form for a small body
+(the relative-velocity / relative-acceleration form of RIFLEX and OrcaFlex)::
+
+    vrel = u_current(z_P) + u_wave(P, t) − v_P                       drag as above
+    F_water = ρ·AE·a_wave(P, t) + Q·diag(AMX, AMY, AMZ)·Qᵀ·a_wave(P, t)  Froude–Krylov + added mass
+
+(with −A·a_p above, the added mass acts on the relative acceleration a_wave − a_p).  A point above
+the instantaneous surface (z_P > η(P, t)) is dry: no drag (current or waves) and no water
+acceleration load; a body crossing the surface switches at its point (a lumped body has no
+size: all or nothing, as its point is wet or dry).  Weight, buoyancy ρ·g·AE and the added
+mass in the mass matrix stay as the deck defines them (constant), wet or dry.
 """
 from dataclasses import dataclass, field
 
@@ -53,8 +66,9 @@ class LumpedBody:
 
     am [kg] mass, ae [m³] displaced volume, icoo 'GLOBAL' or 'LOCAL' (axes of cd and
     added_mass), cd (3,) [N/(m/s)²] quadratic drag per axis, added_mass (3,) [kg]
-    (AMX, AMY, AMZ).  Follows the effect protocol of physics/state.py, plus
-    ``velocity_load`` (see the module docstring for the split of the inertia load).
+    (AMX, AMY, AMZ); waves: feels ``env.water`` when the scene has waves.  Follows the effect
+    protocol of physics/state.py, plus ``velocity_load`` (see the module docstring for the
+    split of the inertia load).
     """
     name: str
     offset: np.ndarray
@@ -63,6 +77,7 @@ class LumpedBody:
     icoo: str = "GLOBAL"
     cd: np.ndarray = field(default_factory=lambda: np.zeros(3))
     added_mass: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    waves: bool = True
 
     def __post_init__(self):
         self.offset, self.cd, self.added_mass = _vec3(self.offset), _vec3(self.cd), _vec3(self.added_mass)
@@ -102,9 +117,23 @@ class LumpedBody:
         rx, ry, rz = rotate(motion.rot_rows, *self.offset.tolist())
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
         px, py, pz = cross_floats(wx, wy, wz, rx, ry, rz)
-        cx, cy, cz = env.current_xyz(float(motion.position[2]) + rz)   # the current at the point
+        ox, oy, oz = motion.position.tolist()
+        cx, cy, cz = env.current_xyz(oz + rz)   # the current at the point
+        water = env.water if self.waves else None
+        gx = gy = gz = 0.0   # the water's acceleration load
+        if water is not None:
+            row = water.at(ox + rx, oy + ry, oz + rz)
+            if water.wet(row, oz + rz):
+                cx, cy, cz = cx + row[0], cy + row[1], cz + row[2]
+                ax, ay, az = row[3:6].tolist()
+                mx, my, mz = self._per_axis(motion, self.added_mass.tolist(), 0, ax, ay, az)
+                fk = env.rho * self.ae
+                gx, gy, gz = fk * ax + mx, fk * ay + my, fk * az + mz
+            else:   # dry: no drag
+                cx, cy, cz = vx + px, vy + py, vz + pz
         ux, uy, uz = cx - (vx + px), cy - (vy + py), cz - (vz + pz)    # water past the point
         fx, fy, fz = self._per_axis(motion, self.cd.tolist(), 1, ux, uy, uz)
+        fx, fy, fz = fx + gx, fy + gy, fz + gz
         fz += env.rho * env.g * self.ae - self.am * env.g
         return np.array((fx, fy, fz) + cross_floats(rx, ry, rz, fx, fy, fz))
 

@@ -379,7 +379,7 @@ class _Judge:
 def realise(h, timdel, tol=0.002, order=None, max_order=40):
     """Realise a sampled kernel h(k·TIMDEL), k = 0…N−1, as h(t) ≈ C·exp(A·t)·B.
 
-    The kernel is zero after its last sample (the convolution ``Convolution`` follows), so
+    The kernel is zero after its last sample (the convention ``Convolution`` follows), so
     the fit sees it followed by N − 1 zero samples: a realisation that goes on past the end
     shows up in its error instead of silently changing the memory load.
     Poles come from the eigenvalue realisation algorithm (ERA: SVD of the Hankel matrix of

@@ -13,7 +13,8 @@ between samples, zero after the last).  Method (stated in the README):
   values; above ω_N: a power tail B_ij(ω) = B_ij(ω_N)·(ω_N/ω)^((p_i + p_j)/2) (the tail matrix
   is D·B(ω_N)·D with D = diag((ω_N/ω)^(p_i/2)): positive semi-definite when B(ω_N) is),
   integrated on a geometric grid up to TAIL_SPAN·ω_N.  Each dof's exponent p_i (P_MIN…P_MAX
-  by P_STEP) is the one whose rebuilt A_ii(ω) agrees best with the database over the grid
+  by P_STEP) is the one whose rebuilt A_ii(ω) agrees best with the database over the grid (the
+  smallest mean |error|)
   (A in the band carries B beyond it, Kramers–Kronig).  Between dofs of different bodies
   (``groups``) the tail decays faster, by (ω_N/ω)^q more: the cross-body B oscillates with
   ω (the waves travel between the bodies, a phase k·d), so beyond the grid its integral mostly
@@ -30,8 +31,10 @@ between samples, zero after the last).  Method (stated in the README):
   by more than DECAY of the curve's peak (searched up to the 2π/Δω the grid's spacing
   resolves), unless asked.
 - A∞: Ogilvie's relation A∞ = A(ω) + (1/ω)·∫₀^L K(t)·sin(ωt) dt with the sampled kernel, the
-  midrange over all grid frequencies (the constant that makes the worst A error smallest), so
-  A∞ and K are consistent; the file's infinite-frequency value is reported against it, and used
+  midrange over all grid frequencies (the constant that makes the worst A error smallest) when
+  those values spread by at most BALANCE of √(A_ii·A_jj), else their median (a resonance
+  between grid points made a few frequencies miss by tens of %, and the midrange moved A∞ by
+  half that everywhere), so A∞ and K are consistent; the file's infinite-frequency value is reported against it, and used
   instead only when asked (``a_inf_from="file"``): with a grid that stops at ω_N, the kernel
   misses what B does beyond, and the file's A∞ then shifts the rebuilt A(ω) by that.
 - Symmetry: A∞, A(ω) and B(ω) are symmetrised; an A∞ asymmetry |A_ij − A_ji| above
@@ -41,7 +44,8 @@ between samples, zero after the last).  Method (stated in the README):
 Quality: A(ω) = A∞ − (1/ω)·∫K̃(t)·sin(ωt) dt and B(ω) = ∫K̃(t)·cos(ωt) dt rebuilt from the
 sampled kernel K̃ exactly as the FMU convolves it, compared with the database at its own
 frequencies: worst error in % of each curve's peak, and in % of the pair's scale
-√(peak_ii·peak_jj) (the diagonal curves' peaks); ``tail_share`` = share of ∫|B| dω beyond ω_N.
+√(peak_ii·peak_jj) (the diagonal curves' peaks); ``tail_share`` = ∫|B_ij| dω beyond ω_N over
+√(∫|B_ii| dω·∫|B_jj| dω) (a pair against its two dofs' whole damping: noise is not a share).
 """
 import time
 from dataclasses import dataclass, field
@@ -60,6 +64,8 @@ P_STEP = 0.25            # tail exponents tried
 CROSS_Q = (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0)   # extra tail exponents tried between bodies
 TAIL_NODES = 400         # geometric nodes of the tail, ω_N…TAIL_SPAN·ω_N
 SYMMETRY_TOL = 0.01      # default A∞ asymmetry tolerance (relative to √(|A_ii|·|A_jj|))
+STRAY = 0.01             # a frequency whose Ogilvie A∞ strays more than this (of √(A_ii·A_jj)) is named
+BALANCE = 0.02           # Ogilvie's A∞: the midrange over the grid when it spreads ≤ 2 % of √(A_ii·A_jj), else the median
 
 
 class AsymmetryError(ValueError):
@@ -87,7 +93,7 @@ class Radiation:
     active (n, n) bool: the pairs kept; omega, a_db, b_db: the (symmetrised) database;
     a_fit, b_fit: the same rebuilt from (a_inf, kernels); err_a, err_b (n, n): worst error in %
     of each curve's peak; pair_a, pair_b (n, n): the same in % of √(peak_ii·peak_jj);
-    tail_share (n, n); tail_exponents (n,); notes: what the transform decided (text lines).
+    tail_share (n, n): ∫|B_ij| beyond ω_N / √(∫|B_ii|·∫|B_jj|); tail_exponents (n,); notes: what the transform decided (text lines).
     """
     a_inf: np.ndarray
     timdel: float
@@ -261,7 +267,7 @@ def _tail_exponents(omega, a, b, k_band, w_tail, sin_all, tail, a_inf, active):
     p = np.full(b.shape[1], slope)
     for i in np.nonzero(np.diag(active))[0]:
         est = (a[:, i, i] + sin_all @ k_band[:, i, i])[:, None] + b[-1, i, i] * s_tail
-        miss = 0.5 * (est.max(0) - est.min(0)) if a_inf is None else np.abs(est - a_inf[i, i]).max(0)
+        miss = _miss(est, np.abs(a[:, i, i]).max(), None if a_inf is None else a_inf[i, i])
         near = miss <= miss.min() + 1e-6 * max(np.abs(a[:, i, i]).max(), 1e-300)
         p[i] = ps[near][np.argmin(np.abs(ps[near] - slope))]
     return p
@@ -282,9 +288,38 @@ def _cross_exponent(omega, a, b, k_band, w_tail, sin_all, tail, pij, cross, a_in
     miss = []
     for q in CROSS_Q:
         est = base + (sin_all @ (w_tail @ ratio ** (pij[i, j] + q)[None, :])) * b[-1, i, j]
-        m = 0.5 * (est.max(0) - est.min(0)) if a_inf is None else np.abs(est - a_inf[i, j]).max(0)
+        m = _miss(est, scale, None if a_inf is None else a_inf[i, j])
         miss.append(np.max(m / np.where(scale > 0, scale, 1.0)))
     return float(CROSS_Q[int(np.argmin(miss))])
+
+
+def _centre(est, scale):
+    """The A∞ the grid frequencies agree on, from Ogilvie's per-frequency values ``est`` (N, …)
+    with ``scale`` (…, broadcast): their midrange (the constant that makes the worst rebuilt A
+    error smallest) when that spreads by at most BALANCE of the scale, else their median.
+    Where B changes faster than the grid resolves (a gap resonance between two bodies, a
+    sharp peak between grid points), a few frequencies miss by tens of % of the peak whatever
+    the kernels, and the midrange moved A∞ by half of that at every frequency; on clean data
+    the midrange spreads the misfit next to ω_N evenly over the band."""
+    mid = 0.5 * (est.max(axis=0) + est.min(axis=0))
+    return np.where(est.max(axis=0) - mid <= BALANCE * scale, mid, np.median(est, axis=0))
+
+
+def _miss(est, scale, a_inf=None):
+    """How far Ogilvie's per-frequency values ``est`` (N, …) stray from A∞ (the given one, or
+    ``_centre``'s): their mean |est − A∞| over the grid.  The mean, not the worst: the tail is
+    chosen by what the bulk of the band says of it, not by the one frequency no tail can fix."""
+    return np.mean(np.abs(est - (_centre(est, scale) if a_inf is None else a_inf)), axis=0)
+
+
+def _where(omega, idx):
+    """Grid frequencies ``omega[idx]`` as runs of neighbours: '1.6…1.8, 2.95'."""
+    runs, start = [], idx[0]
+    for k, nxt in zip(idx, list(idx[1:]) + [None]):
+        if nxt != k + 1:
+            runs.append(f"{omega[start]:g}" + (f"…{omega[k]:g}" if k > start else ""))
+            start = nxt
+    return ", ".join(runs[:4]) + (", …" if len(runs) > 4 else "")
 
 
 def _scales(mats):
@@ -415,8 +450,9 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
     fine = np.linspace(0.0, w_top, 8 * omega.size + 1)
     band = np.trapezoid(np.abs(spline(fine)), fine, axis=0)
     beyond = np.abs(b[-1]) * w_top / (pij - 1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        share = np.where(active, beyond / (band + beyond), 0.0)
+    total = np.diagonal(band + beyond)
+    with np.errstate(invalid="ignore", divide="ignore"):   # a pair's tail against its dofs' whole ∫|B_ii|
+        share = np.where(active, beyond / np.sqrt(np.outer(total, total)), 0.0)
     share = np.nan_to_num(share)
 
     if length is None:
@@ -428,16 +464,28 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
     # rebuild A(ω), B(ω) from the sampled kernels, as the convolution sees them
     rebuilt_a, b_fit = _rebuild(np.zeros((n, n)), kernels, timdel, omega)
     est = a - rebuilt_a                           # Ogilvie: A∞ at each grid frequency
-    fitted = 0.5 * (est.max(axis=0) + est.min(axis=0)) * active
-    spread = np.max(np.abs(est - fitted), axis=0)
+    fitted = _centre(est, scale) * active
     rel = lambda m: 100 * np.max(np.where(active, m, 0) / np.where(scale > 0, scale, 1))
+    ref = a_inf * active if keep_file else fitted
+    with np.errstate(invalid="ignore", divide="ignore"):
+        stray = np.where(active, np.abs(est - ref), 0.0) / np.where(scale > 0, scale, np.inf)
+    off = np.nonzero(stray.max(axis=(1, 2)) > STRAY)[0]
+    if off.size:
+        notes.append(f"Ogilvie's A∞ of {off.size} of the {omega.size} frequencies stray more than {100 * STRAY:g} % "
+                     f"of √(A_ii·A_jj) from the A∞ used, up to {100 * stray.max():.3g} % at {_where(omega, off)} "
+                     f"rad/s: the rebuilt A(ω) misses the database there (B changing faster than the grid "
+                     f"resolves, or next to ω_N: refine the grid there)")
     if keep_file:
         a_inf, src = a_inf * active, "file"
+        notes.append(f"A∞ from the file; the kernels' own (Ogilvie's relation, the median over the frequencies) "
+                     f"differs by ≤ {rel(np.abs(a_inf - fitted)):.3g} % of √(A_ii·A_jj): a_inf = \"ogilvie\" "
+                     f"would move the rebuilt A(ω) by that")
     else:
         src = "Ogilvie"
-        notes.append(f"A∞ from Ogilvie's relation A∞ = A(ω) + (1/ω)·∫K(t)·sin ωt dt over the {omega.size} "
-                     f"frequencies (midrange; half-spread ≤ {rel(spread):.3g} % of √(A_ii·A_jj))"
-                     + (f"; the file's ω = ∞ value differs by ≤ {rel(np.abs(a_inf * active - fitted)):.3g} %"
+        notes.append(f"A∞ from Ogilvie's relation A∞ = A(ω) + (1/ω)·∫K(t)·sin ωt dt: the median over the "
+                     f"{omega.size} frequencies"
+                     + (f"; the file's ω = ∞ value differs by ≤ {rel(np.abs(a_inf * active - fitted)):.3g} % of "
+                        f"√(A_ii·A_jj): a_inf = \"file\" would move the rebuilt A(ω) by that"
                         if a_inf is not None else ""))
         a_inf = fitted
     a_fit = a_inf[None] + rebuilt_a
@@ -457,12 +505,17 @@ def transform(omega, added_mass, damping, a_inf=None, units=None, timdel=None, l
                     f"tail B ~ ω^-p beyond {w_top:g} rad/s with p {pr} per dof, A∞ from "
                     + ("the file" if src == "file" else "Ogilvie's relation")
                     + (f"; between bodies (ω_N/ω)^{q:g} more" if cross.any() else ""))
-    big = share > TAIL_WARN
+    big = np.triu(share > TAIL_WARN)
     if big.any():
-        i, j = np.unravel_index(np.argmax(share), share.shape)
-        warnings.append(f"the frequency range is short for the kernels: the tail beyond {w_top:g} rad/s carries "
-                        f"{100 * share[i, j]:.3g} % of ∫|B|dω for ({names[i]}, {names[j]}) (> {100 * TAIL_WARN:g} %, "
-                        f"{int(big.sum())} pair(s)); extend the frequencies")
+        order = np.argsort(share[big])[::-1]
+        pairs = np.argwhere(big)[order]
+        named = ", ".join(f"({names[i]}, {names[j]}) {100 * share[i, j]:.3g} %" for i, j in pairs[:3])
+        warnings.append(f"the tail beyond the last frequency {w_top:g} rad/s carries more than {100 * TAIL_WARN:g} % "
+                        f"of √(∫|B_ii|dω·∫|B_jj|dω) for {len(pairs)} dof pair(s): {named}"
+                        + (", …" if len(pairs) > 3 else "") + "; the kernels rely there on the fitted tail "
+                        "(exponents chosen so that the rebuilt A(ω) agrees with the database's): check the rebuilt "
+                        "A(ω), B(ω) in the quality report and plot, and solve the BEM to higher frequencies to "
+                        "remove the doubt")
     return Radiation(a_inf=a_inf, timdel=float(timdel), kernels=kernels, active=active, omega=omega,
                      a_db=a, b_db=b, a_fit=a_fit, b_fit=b_fit, err_a=worst(a_fit, a), err_b=worst(b_fit, b),
                      pair_a=worst(a_fit, a, True), pair_b=worst(b_fit, b, True),

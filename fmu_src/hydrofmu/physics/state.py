@@ -6,7 +6,8 @@ Load kernels ("effects") follow one protocol so the FMU wrapper can hold any mix
     uses_current: bool        # needs the current (Env.current_at its point's height)
     uses_acceleration: bool   # has acceleration loads (mass, added mass)
     load(motion, env) -> (6,) # [force N; moment N·m about the reference point], global
-                              # axes, WITHOUT the acceleration loads
+                              # axes, WITHOUT the acceleration loads (an effect in waves reads
+                              # env.water, the incident waves at this step)
     mass_matrix(motion) -> (6, 6)
                               # mass contribution M about the reference point, global
                               # axes; the acceleration load is −M·motion.acceleration
@@ -67,6 +68,7 @@ class Env:
     current_speed: float = 0.0
     current_direction: float = 0.0
     profile: object = None
+    water: object = None   # physics.wave_kinematics.Water: the incident waves at this step (None: still water)
 
     @property
     def current(self):

@@ -6,6 +6,10 @@
     F_body = −V · (w ∘ |w|)              [N; N·m], body axes, moments about the reference point
     F = [R·F_body[0:3] ; R·F_body[3:6]]  global axes
 
+Our extension (``waves = true``, with RELATIVE only; AQWA's hull drag sees the current alone):
+u_c also holds the incident-wave particle velocity at the reference point's instantaneous
+position (physics/wave_kinematics.py), none when that point is above the instantaneous surface.
+
 V_ij [N·s²/m², ...] couples load i with velocity j (AQWA layout, V11 surge … V66 yaw).
 The matrix is taken about the body's reference point: for AQWA data (given at the centre of
 gravity) the scene's reference point should be that centre of gravity.
@@ -23,17 +27,21 @@ class ViscousDrag:
     """Viscous drag load kernel (effect protocol of physics.state).
 
     ``matrix``: 6×6 V matrix, body axes; ``relative``: True for AQWA OPTION=RELATIVE
-    (velocity relative to the current), False for ABSOLUTE.
+    (velocity relative to the current), False for ABSOLUTE; ``waves``: the relative velocity
+    also subtracts the incident waves' (``env.water``; our extension, RELATIVE only).
     """
     name: str
     matrix: np.ndarray
     relative: bool = False
+    waves: bool = False
     uses_acceleration: ClassVar[bool] = False
 
     def __post_init__(self):
         self.matrix = np.array(self.matrix, dtype=float)
         if self.matrix.shape != (6, 6):
             raise ValueError(f"viscous drag matrix must be 6×6, got {self.matrix.shape}")
+        if self.waves and not self.relative:
+            raise ValueError("viscous drag: waves = true needs the RELATIVE option (the velocity relative to the water)")
 
     @property
     def uses_current(self):
@@ -45,7 +53,12 @@ class ViscousDrag:
         rows = motion.rot_rows
         vx, vy, vz, wx, wy, wz = motion.velocity.tolist()
         if self.relative:   # the current at the reference point
-            cx, cy, cz = env.current_xyz(float(motion.position[2]))
+            x, y, z = motion.position.tolist()
+            cx, cy, cz = env.current_xyz(z)
+            if self.waves and env.water is not None:
+                row = env.water.at(x, y, z)
+                if env.water.wet(row, z):
+                    cx, cy, cz = cx + row[0], cy + row[1], cz + row[2]
             vx, vy, vz = vx - cx, vy - cy, vz - cz
         w = rotate_back(rows, vx, vy, vz) + rotate_back(rows, wx, wy, wz)
         fx, fy, fz, mx, my, mz = self.matrix.dot([x * abs(x) for x in w]).tolist()   # −F_body
@@ -57,5 +70,5 @@ class ViscousDrag:
     C_TAG = "drag"   # its record in a compiled FMU (viscous_drag.c)
 
     def c_params(self):
-        """viscous_drag.c's parameters: [relative, matrix (36, row-major)]."""
-        return [float(self.relative)] + self.matrix.ravel().tolist()
+        """viscous_drag.c's parameters: [relative (0, 1; 2: RELATIVE with waves), matrix (36, row-major)]."""
+        return [float(self.relative) + float(self.waves)] + self.matrix.ravel().tolist()

@@ -1,15 +1,15 @@
 /* First-order waves (physics/waves.py, the readable reference): a sea state's components,
- * a body's transfer function interpolated at them, and the excitation and elevation at time t.
+ * a body's transfer function interpolated at them, the shared per-step phasors, and the
+ * excitation and elevation at time t.
  *
  * hf_wave_build runs once per initialization (the sea state the waves.* parameters hold
  * then): it draws the components exactly as physics.waves.components does, with numpy's
  * default_rng (PCG64 seeded through SeedSequence, reproduced here bit for bit: the same seed
- * gives the same wave field in both flavours), and stacks WaveLoad's table.  hf_waves is the
- * per-step kernel: out (7) = r(t) sum_k [cos(w_k t) table[k] + sin(w_k t) table[n + k]].
- * The phases are cos/sin of w_k t at every step, not a rotation advanced step by step: a
- * rotation accumulates one rounding per step per component (1e-10 of the amplitude after
- * ~1e6 steps) and would need the communication step to stay fixed; cos/sin is exact at any t
- * and still O(components x 7) a step.
+ * gives the same wave field in both flavours), and stacks WaveLoad's table.  The phasors
+ * (waves.Phasors) p_k = a_k e^{i(w_k t + phi_k)} are advanced once per step for the whole FMU
+ * by one complex multiply per component, set exactly every HF_RESYNC steps and whenever t is
+ * off the step grid (variable steps, restored states); hf_waves is then
+ * out (7) = r(t) sum_k Re(p_k T_k), T_k = [X(w_k, beta_k), e^{-i k.x}].
  */
 #include <math.h>
 #include <stdint.h>
@@ -159,6 +159,7 @@ static double wrap360(double a) { return a - 360.0 * floor(a / 360.0); }
 static int transfer_init(Transfer *T, const double *p, double g, double depth) {
     T->x = p[2], T->y = p[3], T->closed = p[4] != 0.0, T->nw = (int)p[5], T->nb = (int)p[6];
     T->w = p + 7, T->d = T->w + T->nw;
+    if (T->nw == 0) return 0;   /* no excitation: the window alone */
     const double *re = T->d + T->nb, *im = re + 6 * T->nw * T->nb;
     T->local = malloc(sizeof(double) * 12 * T->nw * T->nb);
     if (!T->local) return -1;
@@ -176,12 +177,11 @@ static int transfer_init(Transfer *T, const double *p, double g, double depth) {
     return 0;
 }
 
-/* TransferFunction._direction_weights for one direction; -1: outside the computed ones */
-static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
-    const double *d = T->d;
-    int nb = T->nb;
+/* TransferFunction._direction_weights for one direction over the directions d (nb, sorted
+ * in [0, 360)), closed when they go round the circle; -1: outside the computed ones */
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac) {
     beta = wrap360(beta);
-    if (T->closed) {
+    if (closed) {
         if (beta < d[0]) beta += 360.0;   /* below the first: across the wrap from the last */
         int j = 0;   /* searchsorted(ext, beta, 'right') - 1, clipped to 0 ... nb - 1 */
         while (j < nb && (j + 1 < nb ? d[j + 1] : d[0] + 360.0) <= beta) j++;
@@ -206,11 +206,19 @@ static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, d
     return 0;
 }
 
+static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
+    return hf_direction_weights(T->d, T->nb, T->closed, beta, j0, j1, frac);
+}
+
 /* TransferFunction.at for one component: X (6 complex, (re, im) pairs) referred to the origin */
 static int transfer_at(const Transfer *T, double omega, double beta, double g, double depth, double *x,
                        char *message, size_t size) {
     const double *w = T->w;
     int nw = T->nw;
+    if (nw == 0) {   /* no excitation */
+        memset(x, 0, sizeof(double) * 12);
+        return 0;
+    }
     if (omega < w[0] * (1 - 1e-9) || omega > w[nw - 1] * (1 + 1e-9)) {
         snprintf(message, size, "omega = %g rad/s is outside the transfer function's frequencies %g...%g rad/s",
                  omega, w[0], w[nw - 1]);
@@ -302,7 +310,7 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
     if (hf_sea_check(sea, field, m, size)) return NULL;
     const double lo_w = transfer[0], hi_w = transfer[1];
     int n = sea->spectrum == 0 ? 1 : (int)sea->components;
-    double *params = malloc(sizeof(double) * (2 + n + 14 * n)), *w = malloc(sizeof(double) * 4 * n);
+    double *params = malloc(sizeof(double) * (2 + 3 * n + 14 * n + n)), *w = malloc(sizeof(double) * 4 * n);
     double *amp = w + n, *beta = amp + n, *phase = beta + n;
     Spectrum *sp = NULL;
     Transfer T = {0};
@@ -345,25 +353,22 @@ double *hf_wave_build(const HfSea *sea, const double *transfer, double g, char *
         }
         for (int k = 0; k < n; k++) amp[k] = sqrt(2 * scale * shape(w[k], sea->tp, gamma) * dw);
     }
-    /* WaveLoad: c_k = a e^{i phi} [X(w, beta), e^{-i k x}], stacked as [Re; -Im] */
+    /* WaveLoad: T_k = [X(w, beta), e^{-i k x}], rows 2k, 2k + 1: Re T_k, -Im T_k; a e^{i phi} apart */
     if (transfer_init(&T, transfer, g, sea->depth)) goto oom;
     params[0] = n, params[1] = sea->ramp;
-    double *omega = params + 2, *table = omega + n;
+    double *omega = params + 2, *ampl = omega + n, *table = ampl + 2 * n;
     for (int k = 0; k < n; k++) {
         double x[12], kw = hf_wave_number(w[k], g, sea->depth), b = beta[k] * PI / 180.0;
         if (transfer_at(&T, w[k], beta[k], g, sea->depth, x, m, size)) {
             strcpy(field, strncmp(m, "wave direction", 14) == 0 ? "direction" : "omega");
             goto bad;
         }
-        double cr = amp[k] * cos(phase[k]), ci = amp[k] * sin(phase[k]);
-        double ph = -kw * (T.x * cos(b) + T.y * sin(b)), er = cos(ph), ei = sin(ph);
+        double ph = -kw * (T.x * cos(b) + T.y * sin(b));
         omega[k] = w[k];
-        for (int q = 0; q < 6; q++) {
-            table[7 * k + q] = cr * x[2 * q] - ci * x[2 * q + 1];
-            table[7 * (n + k) + q] = -(cr * x[2 * q + 1] + ci * x[2 * q]);
-        }
-        table[7 * k + 6] = cr * er - ci * ei;
-        table[7 * (n + k) + 6] = -(cr * ei + ci * er);
+        ampl[2 * k] = amp[k] * cos(phase[k]), ampl[2 * k + 1] = amp[k] * sin(phase[k]);
+        for (int q = 0; q < 6; q++) table[14 * k + q] = x[2 * q], table[14 * k + 7 + q] = -x[2 * q + 1];
+        table[14 * k + 6] = cos(ph), table[14 * k + 13] = -sin(ph);
+        table[14 * n + k] = beta[k];
     }
     free(T.local), free(sp), free(w);
     return params;
@@ -375,18 +380,101 @@ bad:
     return NULL;
 }
 
-void hf_waves(const double *params, double t, double *out) {
+/* -- the phasors (waves.Phasors) ------------------------------------------------------- */
+
+static double ulp(double x) { x = fabs(x); return nextafter(x, INFINITY) - x; }
+
+HfPhasors *hf_phasors_new(const double *omega, const double *amp, int n, double ramp, int resync) {
+    HfPhasors *P = calloc(1, sizeof *P);
+    double *p = malloc(sizeof(double) * 4 * (n > 0 ? n : 1));
+    if (!P || !p) {
+        free(P), free(p);
+        return NULL;
+    }
+    P->n = n, P->resync = resync, P->ramp = ramp, P->omega = omega, P->amp = amp;
+    P->p = p, P->rot = p + 2 * n, P->t = NAN;
+    return P;
+}
+
+void hf_phasors_delete(HfPhasors *P) {
+    if (P) free(P->p);
+    free(P);
+}
+
+static void phasors_exact(HfPhasors *P, double t) {
+    for (int k = 0; k < P->n; k++) {
+        double c = cos(P->omega[k] * t), s = sin(P->omega[k] * t), ar = P->amp[2 * k], ai = P->amp[2 * k + 1];
+        P->p[2 * k] = ar * c - ai * s, P->p[2 * k + 1] = ar * s + ai * c;
+    }
+    P->exact++, P->sync = t, P->j = 0;
+}
+
+const double *hf_phasors_at(HfPhasors *P, double t) {
+    if (t == P->t) return P->p;
+    double prev = P->t;
+    P->t = t;
+    if (P->has_rot && P->j < P->resync && P->h > 0) {
+        double grid = P->sync + (P->j + 1) * P->h, big = fabs(t) > fabs(grid) ? fabs(t) : fabs(grid);
+        if (fabs(t - grid) <= HF_GRID_ULPS * ulp(big)) {
+            double *p = P->p;
+            const double *f = P->rot;
+            for (int k = 0; k < P->n; k++) {
+                double a = p[2 * k], b = p[2 * k + 1], c = f[2 * k], s = f[2 * k + 1];
+                p[2 * k] = a * c - b * s, p[2 * k + 1] = a * s + b * c;
+            }
+            P->j++, P->rotations++;
+            return P->p;
+        }
+    }
+    double h = t - prev;
+    phasors_exact(P, t);
+    if (!(isfinite(h) && h > 0)) {
+        P->h = 0.0, P->has_rot = 0;
+    } else if (!P->has_rot || fabs(h - P->h) > HF_GRID_ULPS * ulp(t)) {   /* a new step length */
+        for (int k = 0; k < P->n; k++) P->rot[2 * k] = cos(P->omega[k] * h), P->rot[2 * k + 1] = sin(P->omega[k] * h);
+        P->h = h, P->has_rot = 1;
+    }
+    return P->p;
+}
+
+/* the phasors' state (an FMU state holds it: a run restored continues bit for bit):
+ * [t, sync, j, h, has_rot, p (2n)]; the rotation is recomputed from h */
+size_t hf_phasors_state_size(const HfPhasors *P) { return 5 + 2 * (size_t)P->n; }
+
+void hf_phasors_save(const HfPhasors *P, double *to) {
+    to[0] = P->t, to[1] = P->sync, to[2] = P->j, to[3] = P->h, to[4] = P->has_rot;
+    memcpy(to + 5, P->p, sizeof(double) * 2 * P->n);
+}
+
+int hf_phasors_load(HfPhasors *P, const double *from, size_t n) {
+    if (n != hf_phasors_state_size(P) || !(from[2] >= 0 && from[2] <= P->resync)) return -1;
+    P->t = from[0], P->sync = from[1], P->j = (int)from[2], P->h = from[3], P->has_rot = from[4] != 0.0;
+    memcpy(P->p, from + 5, sizeof(double) * 2 * P->n);
+    if (P->has_rot)
+        for (int k = 0; k < P->n; k++) P->rot[2 * k] = cos(P->omega[k] * P->h), P->rot[2 * k + 1] = sin(P->omega[k] * P->h);
+    return 0;
+}
+
+double hf_phasors_ramp(const HfPhasors *P) {
+    double t = P->t, length = P->ramp;
+    if (!(t < length)) return 1.0;
+    return t <= 0.0 ? 0.0 : 0.5 * (1.0 - cos(PI * t / length));
+}
+
+HfPhasors *hf_wave_phasors(const double *params) {
     int n = (int)params[0];
-    double length = params[1];
-    const double *omega = params + 2, *table = omega + n;
-    memset(out, 0, sizeof(double) * 7);
+    return hf_phasors_new(params + 2, params + 2 + n, n, params[1], HF_RESYNC);
+}
+
+void hf_waves(const double *params, HfPhasors *P, double t, double *out) {
+    int n = (int)params[0];
+    const double *table = params + 2 + 3 * n, *p = hf_phasors_at(P, t);
+    double acc[7] = {0};   /* (local sums: out may alias, these stay in registers) */
     for (int k = 0; k < n; k++) {
-        double c = cos(omega[k] * t), s = sin(omega[k] * t);
-        const double *a = table + 7 * k, *b = table + 7 * (n + k);
-        for (int j = 0; j < 7; j++) out[j] += c * a[j] + s * b[j];
+        double re = p[2 * k], im = p[2 * k + 1];
+        const double *a = table + 14 * k, *b = a + 7;
+        for (int j = 0; j < 7; j++) acc[j] += re * a[j] + im * b[j];
     }
-    if (t < length) {
-        double r = t <= 0.0 ? 0.0 : 0.5 * (1.0 - cos(PI * t / length));
-        for (int j = 0; j < 7; j++) out[j] *= r;
-    }
+    double r = hf_phasors_ramp(P);
+    for (int j = 0; j < 7; j++) out[j] = r * acc[j];
 }

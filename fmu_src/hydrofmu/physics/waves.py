@@ -32,7 +32,8 @@ Sea states (``SeaState``)
 
 What is linear, what is not modelled: the excitation acts at the body's mean position (the
 scene's pose), not where the body is; no second-order (drift, sum/difference-frequency)
-loads; no wave kinematics for Morison / drag terms (drag effects see the current only).
+loads here (a drift load takes the same ``Phasors``); the incident-wave kinematics of the
+same components are physics/wave_kinematics.py's.
 """
 from __future__ import annotations
 
@@ -42,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 SPECTRA = ("regular", "jonswap", "pierson_moskowitz")
+STRETCHING = ("none", "vertical", "wheeler", "extrapolation")   # wave_kinematics.py's options
 TAIL = 0.005           # share of the spectrum's energy the band leaves out (half on each side)
 MAX_OUTSIDE = 0.02     # largest share of the spectrum allowed outside the transfer functions' frequencies
 DIRECTION_TOL = 1e-6   # deg: a heading this close to a computed one is that one
@@ -62,7 +64,8 @@ class SeaState:
     spectrum: one of SPECTRA; regular waves: height H [m], period T [s], phase [deg];
     spectra: hs [m], tp [s], gamma (JONSWAP peak enhancement, ≥ 1); direction [deg, going to,
     counter-clockwise from +x]; spreading s (cos-2s, 0: long-crested); components N; seed;
-    ramp [s]; depth [m] (inf: deep water)."""
+    ramp [s]; depth [m] (inf: deep water); stretching: the kinematics above the mean water
+    level (physics/wave_kinematics.py)."""
     spectrum: str = "jonswap"
     hs: float = 0.0
     tp: float = 10.0
@@ -76,6 +79,7 @@ class SeaState:
     seed: int = 1
     ramp: float = 0.0
     depth: float = math.inf
+    stretching: str = "wheeler"   # the kinematics above the mean water level (wave_kinematics.STRETCHING)
 
     def check(self):
         """Raise WaveError naming the first bad knob."""
@@ -107,6 +111,8 @@ class SeaState:
             raise WaveError("depth", f"must be positive (inf: deep water), found {self.depth:g} m")
         if self.seed != int(self.seed) or self.seed < 0:
             raise WaveError("seed", f"must be a non-negative integer, found {self.seed:g}")
+        if self.stretching not in STRETCHING:
+            raise WaveError("stretching", f"expected one of {', '.join(STRETCHING)}, found {self.stretching!r}")
 
 
 def wave_number(omega, g=9.81, depth=math.inf):
@@ -326,36 +332,129 @@ class TransferFunction:
         return x * np.exp(-1j * k * (self.position[0] * np.cos(b) + self.position[1] * np.sin(b)))
 
 
+RESYNC = 1024          # steps between two exact resynchronisations of the phasors
+GRID_ULPS = 4          # a time this many ulp(t) from the phasors' step grid is on it
+
+
+class Phasors:
+    """The complex amplitudes of every wave component at the FMU's time, advanced once per
+    step for the whole FMU and shared by every wave effect (excitation, kinematics, drift).
+
+    p_k(t) = a_k·e^{i(ω_k·t + φ_k)} (un-ramped, complex (n,)); the ramp r(t) is ``ramp_factor``,
+    and ``z`` = r(t)·p(t), so that η = Re Σ z_k·e^{−ik·x} at a point x and the excitation is
+    Re Σ z_k·X_k (the e^{+iωt} convention of this module).
+
+    Advancing: ``at(t)`` moves p to time t [s] and returns it (idempotent: every effect of a
+    step calls it with the same t, the first call does the work).  A step of the same length h
+    as the previous one costs one complex multiply per component, p ← p·e^{iω_k·h}.  Every
+    ``resync`` steps, and whenever t is not the next point of the grid t_sync + j·h (a step of
+    another length, a restored FMU state, a jump back), p is set exactly, a_k·e^{i(ω_k t + φ_k)}
+    (N sines and cosines; a new step length costs N more for e^{iω_k h}).  Variable steps are
+    therefore exact, at the cost of the trigonometry on each step that changes length.
+
+    Round-off bound: each rotation adds at most ~4ε of |a_k| (ε = 2.2e-16: the product's
+    rounding and that of e^{iω_k h}), so between two resynchronisations
+    |p_k − a_k e^{i(ω_k t + φ_k)}| ≤ 4·ε·resync·|a_k| (≈ 1e-12·|a_k| for resync = 1024), plus the
+    grid's time tolerance: a t within GRID_ULPS·ulp(t) of the grid point is taken as it (the
+    master's t = n·h and t_sync + j·h differ by a rounding), a phase error ≤ ω_k·GRID_ULPS·ulp(t)
+    (4e-11 rad at t = 3 h, ω = 5 rad/s); the exact evaluation itself carries the rounding of its
+    argument ω_k·t + φ_k, ε·(ω_k t + 2π) (2e-12 rad at t = 3 h, ω = 1 rad/s), so the phasors are
+    as accurate as the cosines they replace.  tests/test_wave_kinematics.py holds the sum of
+    these over a 3-hour record with fixed and variable steps.
+    """
+
+    def __init__(self, comps: Components, ramp_length: float = 0.0, resync: int = RESYNC):
+        self.omega = np.asarray(comps.omega, dtype=float)
+        self.amplitude = np.asarray(comps.amplitude, dtype=float) * np.exp(1j * np.asarray(comps.phase, dtype=float))
+        self.ramp_length = float(ramp_length)
+        self.resync = int(resync)
+        self.p = np.empty(self.omega.size, complex)
+        self.t = math.nan
+        self._sync, self._j, self._h, self._rot = 0.0, 0, 0.0, None
+        self.rotations = self.exact = 0   # counts, for the tests and the bench
+
+    def _exact(self, t):
+        np.multiply(self.amplitude, np.exp(1j * (self.omega * t)), out=self.p)
+        self.exact += 1
+        self._sync, self._j = t, 0
+
+    def at(self, t: float) -> np.ndarray:
+        """p(t) (complex (n,), un-ramped; do not modify it)."""
+        if t == self.t:
+            return self.p
+        prev, self.t = self.t, t
+        if self._rot is not None and self._j < self.resync and self._h > 0:
+            grid = self._sync + (self._j + 1) * self._h
+            if abs(t - grid) <= GRID_ULPS * math.ulp(max(abs(t), abs(grid))):
+                self.p *= self._rot
+                self._j += 1
+                self.rotations += 1
+                return self.p
+        h = t - prev
+        self._exact(t)
+        if not (math.isfinite(h) and h > 0):
+            self._h, self._rot = 0.0, None
+        elif self._rot is None or abs(h - self._h) > GRID_ULPS * math.ulp(abs(t)):
+            # a new step length (one within the rounding of t of the old one is the old one:
+            # t − t_prev of a master's t = n·h is h ± ulp(t), and the grid keeps the master's h)
+            self._rot = np.exp(1j * (self.omega * h))
+            self._h = h
+        return self.p
+
+    def state(self) -> dict:
+        """The phasors' state (an FMU state holds it: a restored run continues bit for bit)."""
+        return {"t": self.t, "sync": self._sync, "j": self._j, "h": self._h, "rot": self._rot is not None,
+                "p": self.p.view(float).tolist()}
+
+    def set_state(self, state: dict):
+        self.t, self._sync, self._j, self._h = state["t"], state["sync"], state["j"], state["h"]
+        self.p.view(float)[:] = state["p"]
+        self._rot = np.exp(1j * (self.omega * self._h)) if state["rot"] else None
+
+    @property
+    def ramp_factor(self) -> float:
+        """r(t) at the phasors' time."""
+        return ramp(self.t, self.ramp_length) if self.t < self.ramp_length else 1.0
+
+    def z(self, t: float) -> np.ndarray:
+        """r(t)·a_k·e^{i(ω_k t + φ_k)} (a new array)."""
+        p = self.at(t)
+        return p * self.ramp_factor
+
+    def c_params(self):
+        """waves.c's phasor record: [n, resync, ramp length, ω (n), a e^{iφ} (re, im pairs)]."""
+        return ([float(self.omega.size), float(self.resync), self.ramp_length] + self.omega.tolist()
+                + self.amplitude.view(float).tolist())
+
+
 class WaveLoad:
     """The per-step wave kernel of one body: excitation [N, N·m] (global axes, about the
     reference point) and the elevation [m] at the reference point, at time t [s].
 
-    Built once per sea state: per component, c_k = a_k·e^{iφ_k}·[X(ω_k, β_k), e^{−ik·x}]
-    (7 complex numbers), stacked as the real matrix [Re c; −Im c] (2N × 7).  A step then
-    costs N cosines, N sines and one (2N)·7 product: O(N × dofs), nothing else recomputed.
+    Built once per sea state: per component, T_k = [X(ω_k, β_k), e^{−ik·x}] (7 complex
+    numbers), stacked as the real matrix whose rows 2k, 2k + 1 are Re T_k, −Im T_k (2N × 7), so
+    that Re Σ_k p_k·T_k is p viewed as interleaved (re, im) floats times it.  A step costs the
+    shared ``Phasors`` advance (one complex multiply per component, shared with every other
+    wave effect of the FMU) and one (2N)·7 product.
     """
 
     def __init__(self, comps: Components, transfer: TransferFunction | None, point, ramp_length=0.0,
-                 g=9.81, depth=math.inf):
+                 g=9.81, depth=math.inf, phasors: Phasors | None = None):
         w = np.asarray(comps.omega, dtype=float)
         b = np.radians(comps.direction)
         k = wave_number(w, g, depth)
-        c = comps.amplitude * np.exp(1j * comps.phase)
-        eta = c * np.exp(-1j * k * (point[0] * np.cos(b) + point[1] * np.sin(b)))
+        eta = np.exp(-1j * k * (point[0] * np.cos(b) + point[1] * np.sin(b)))
         x = transfer.at(w, comps.direction) if transfer is not None else np.zeros((w.size, 6), complex)
-        table = np.column_stack((c[:, None] * x, eta))
+        table = np.column_stack((x, eta))
         self.omega = w
-        self.table = np.vstack((table.real, -table.imag))
-        self.ramp = float(ramp_length)
-        self._trig = np.empty(2 * w.size)
+        self.table = np.empty((2 * w.size, 7))
+        self.table[0::2], self.table[1::2] = table.real, -table.imag
+        self.phasors = phasors if phasors is not None else Phasors(comps, ramp_length)
+        self.ramp = self.phasors.ramp_length
 
     def __call__(self, t):
         """(7,) [Fx, Fy, Fz, Mx, My, Mz, η] at time t."""
-        n = self.omega.size
-        wt = self.omega * t
-        np.cos(wt, out=self._trig[:n])
-        np.sin(wt, out=self._trig[n:])
-        out = self._trig.dot(self.table)
+        out = self.phasors.at(t).view(float).dot(self.table)
         if t < self.ramp:
             out *= ramp(t, self.ramp)
         return out

@@ -6,7 +6,7 @@ from .. import keys
 from ..admissible import depth_mismatch
 from ..decks.bem import PERIOD_VARIABLES
 from ..description import HydroCoupling, Kernel
-from ..errors import InputError
+from ..errors import InputError, numbers
 from ..names import did_you_mean
 from .problems import deck_path, deck_units, identifier
 from .run import MEMORY_DEFAULTS
@@ -157,10 +157,14 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
                 raise InputError(path, None, "rotation_centers", f"{b!r} is not a body of the result "
                                                                  f"(it has: {', '.join(data.bodies)})")
             if b in data.rotation_centers and np.max(np.abs(np.subtract(data.rotation_centers[b], xyz))) > CENTRE_TOL:
-                raise InputError(path, None, f"rotation_center[{b}]", f"{data.rotation_centers[b]} m in the file "
-                                                                      f"but {xyz} m declared in the scene")
+                raise InputError(path, None, f"rotation_center[{b}]", f"{numbers(data.rotation_centers[b])} m in "
+                                                                      f"the file but {numbers(xyz)} m declared in the scene")
             data.rotation_centers[b] = list(xyz)
-        _check_centres(data, mapping, bodies)
+        for b, message in _check_centres(data, mapping, bodies):
+            problems.add_once(("rotation_center", str(path), b), f"{where}.bem",
+                              f"{path}: rotation_center[{b}]: {message}")
+        if any(("rotation_center", str(path), b) in problems.facts for b in data.bodies):
+            return []
         result = bem.couplings(data, mapping, dofs, opt["timdel"], opt["kernel_length"],
                                opt["symmetry_tolerance"] or SYMMETRY_TOL, prefix, a_inf_from)
     except InputError as exc:
@@ -177,18 +181,22 @@ def _bem_couplings(problems, table, where, bodies, memory, env):
 
 def _check_centres(data, mapping, bodies):
     """BEM rotation centres = the scene bodies' reference points, up to one horizontal shift
-    (radiation coefficients do not change when the whole group moves horizontally)."""
+    (radiation coefficients do not change when the whole group moves horizontally): the
+    [(BEM body, message)] of those that do not match."""
     known = [b for b in data.bodies if b in mapping and b in data.rotation_centers]
     if not known:
-        return
+        return []
     ref = known[0]
-    shift = np.array(bodies[mapping[ref]].position) - np.array(data.rotation_centers[ref])
+    shift = np.array(bodies[mapping[ref]].position, float) - np.array(data.rotation_centers[ref], float)
     shift[2] = 0.0
+    out = []
     for b in known:
-        want = np.array(bodies[mapping[b]].position)
-        got = np.array(data.rotation_centers[b]) + shift
+        want = np.array(bodies[mapping[b]].position, float)
+        got = np.array(data.rotation_centers[b], float) + shift
         if np.max(np.abs(got - want)) > CENTRE_TOL:
-            raise InputError(data.path, None, f"rotation_center[{b}]",
-                             f"{data.rotation_centers[b]} m does not match the reference point of scene body "
-                             f"{mapping[b]!r} at {list(want)} m (z must agree, x and y up to one common shift "
-                             f"{shift[:2].tolist()} m); the coefficients must be about the reference point")
+            moved = f" after the common shift {numbers(shift[:2])} m of x, y" if np.any(shift[:2]) else ""
+            out.append((b, f"{numbers(data.rotation_centers[b])} m in the file but the reference point of scene body "
+                           f"{mapping[b]!r} is at {numbers(want)} m (bodies.{mapping[b]}.position){moved}: the "
+                           f"coefficients are about the rotation centre (move the body there, or solve again about "
+                           f"its reference point)"))
+    return out

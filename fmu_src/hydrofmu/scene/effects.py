@@ -14,7 +14,8 @@ def _aqwa_viscous_drag(problems, table, where):
         data, _ = from_deck(problems, table, where, read_viscous_drag, "body")
         if data is None:
             return None
-        return {"matrix": np.asarray(data.matrix).tolist(), "relative": data.option == "RELATIVE"}
+        return _drag_waves(problems, table, where, {"matrix": np.asarray(data.matrix).tolist(),
+                                                     "relative": data.option == "RELATIVE"})
     problems.known_keys(table, where, keys.effect_keys("aqwa_viscous_drag", False))
     matrix = problems.matrix(table, "matrix", f"{where}.matrix", 6)
     option = problems.choice(table, "option", f"{where}.option", ("ABSOLUTE", "RELATIVE"), "ABSOLUTE")
@@ -22,7 +23,28 @@ def _aqwa_viscous_drag(problems, table, where):
         return None
     for k, message in admissible.negative_diagonal(matrix):
         problems.warn(f"{where}.matrix[{k + 1},{k + 1}]", message)
-    return {"matrix": matrix, "relative": option == "RELATIVE"}
+    return _drag_waves(problems, table, where, {"matrix": matrix, "relative": option == "RELATIVE"})
+
+
+def _flag(problems, table, key, where):
+    """A boolean key (default false), or None after recording the problem."""
+    value = table.get(key, False)
+    if not isinstance(value, bool):
+        problems.add(where, f"expected true or false, found {value!r}")
+        return None
+    return value
+
+
+def _drag_waves(problems, table, where, data):
+    """The drag's opt-in ``waves`` (our extension; RELATIVE only)."""
+    waves = _flag(problems, table, "waves", f"{where}.waves")
+    if waves is None:
+        return None
+    if waves and not data["relative"]:
+        problems.add(f"{where}.waves", "waves = true needs the RELATIVE option (the drag on the velocity relative "
+                                       "to the water); this drag is ABSOLUTE")
+        return None
+    return {**data, "waves": waves}
 
 
 def _deeplines_current_polar(problems, table, where):
@@ -59,8 +81,11 @@ def _deeplines_current_polar(problems, table, where):
             key = "symmetry" if "symmetry" in exc.message else "table"
             problems.add(f"{where}.{key}", f"{exc.field}: {exc.message}")
         return None
+    waves = _flag(problems, table, "waves", f"{where}.waves")
+    if waves is None:
+        return None
     return {"angles": angles.tolist(), "cx": cx.tolist(), "cy": cy.tolist(), "cmz": cmz.tolist(),
-            "point": [data.xc, data.yc, data.zc], "surface": data.surfc}
+            "point": [data.xc, data.yc, data.zc], "surface": data.surfc, "waves": waves}
 
 
 LUMPED_KEYS = keys.names(keys.LUMPED)
@@ -166,9 +191,44 @@ def _bem_hydrostatics(problems, table, where):
             "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g}
 
 
+def _wave_drift(problems, table, where):
+    """Second-order wave drift from a BEM result (WAMIT .7/.8/.9/.10d/.11d/.12d, Capytaine
+    dataset with the far-field drift): mean drift or the difference-frequency QTF of one BEM
+    body, ``method`` mean | newman | qtf; the sea state is the scene's [waves]."""
+    import math
+
+    from ..decks.drift import QTF_SUFFIXES, read_mean_drift, read_qtf
+    problems.known_keys(table, where, keys.effect_keys("wave_drift", False))
+    method = problems.choice(table, "method", f"{where}.method", ("mean", "newman", "qtf"), "newman")
+    cutoff = problems.number(table, "cutoff", f"{where}.cutoff", positive=True) if "cutoff" in table else math.inf
+    if method is None or cutoff is None:
+        return None
+    if "cutoff" in table and method != "qtf":
+        problems.add(f"{where}.cutoff", f"applies to method = \"qtf\" only (this effect's method is {method!r})")
+        return None
+    qtf = method == "qtf"
+    if qtf and not str(table.get("bem", "")).endswith(QTF_SUFFIXES):
+        problems.add(f"{where}.bem", "method = \"qtf\" needs a difference-frequency QTF: a WAMIT .10d, .11d or .12d "
+                                     "file (mean drift files hold the diagonal only: use method = \"newman\")")
+        return None
+    data, path, body = _bem_entry(problems, table, where, read_qtf if qtf else read_mean_drift)
+    if data is None:
+        return None
+    for message in data.warnings:
+        problems.warn(f"{where}.bem", message)
+    out = {"bem": str(path), "body": body, "kind": data.kind, "method": method, "cutoff": cutoff,
+           "omega": data.omega.tolist(), "rotation_center": data.rotation_centers.get(body), "rho": data.rho,
+           "g": data.g, "water_depth": data.water_depth}
+    if qtf:
+        q = data.body(body)
+        return {**out, "pairs": [list(p) for p in data.pairs], "re": q.real.tolist(), "im": q.imag.tolist()}
+    return {**out, "directions": data.directions.tolist(), "values": data.body(body).tolist()}
+
+
 # type -> (validator, default effect name)
 EFFECT_TYPES = {
     "wave_excitation": (_wave_excitation, "waves"),
+    "wave_drift": (_wave_drift, "drift"),
     "bem_hydrostatics": (_bem_hydrostatics, "hydrostatics"),
     "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
     "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),

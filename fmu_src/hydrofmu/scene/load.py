@@ -13,7 +13,7 @@ from .current import read_current
 from .joints import read_joint
 from .problems import Problems, identifier
 from .run import read_run, stable_defaults
-from .waves import check_wave_effects, read_waves
+from .waves import check_wave_effects, feels_waves, read_wave_points, read_waves
 
 SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")
 RUNTIMES = tuple(keys.BUILD["runtime"][0]["enum"])   # [build] runtime: fmi/build.py, fmi/cbuild.py
@@ -36,6 +36,7 @@ class Scene:
     decks: list = field(default_factory=list)   # decks.lines.Reading of each deck read: used, skipped, warnings
     runtime: str = "python"          # [build] runtime: "python" (pythonfmu) or "c" (compiled)
     waves: object = None             # physics.waves.SeaState of [waves], or None (no waves)
+    wave_points: dict = field(default_factory=dict)   # [waves.points]: name -> {position} or {body, offset}
 
 
 def load_scene(path, overrides=None):
@@ -103,7 +104,9 @@ def _load_scene(path, overrides=None):
                                 {"rho": rho, "g": g, "depth": sea.depth if sea is not None else None})
                  if "couplings" in doc else [])
     speed, direction, profile = read_current(p, env)
-    check_wave_effects(p, bodies, sea, rho, g)
+    points = read_wave_points(p, doc["waves"], bodies) if "waves" in doc else {}
+    feels = bool(points) or bool(joints) or any(feels_waves(e) for b in bodies.values() for e in b.effects)
+    check_wave_effects(p, bodies, sea, rho, g, feels)
     _check_names(p, bodies, joints, couplings)
     if not p.items:   # defaults for what a valid scene holds (a scene with problems is refused below)
         stable_defaults(run_cfg, bodies, couplings, sea,
@@ -112,6 +115,7 @@ def _load_scene(path, overrides=None):
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
         bodies=bodies, run=run_cfg, decks=p.readings, runtime=runtime or "python", waves=sea,
+        wave_points=points if sea is not None else {},
     )
     p.raise_if_any()
     return scene

@@ -18,6 +18,7 @@ class Problems:
         self.unknown = {}  # key path of an unknown key -> the keys allowed there (batch knobs are checked by it)
         self.decks = {}   # (deck path, reader, args) -> entries or the InputError: each deck read once
         self.readings = []   # what each deck read gave: groups used and skipped, warnings (decks.lines.Reading)
+        self.facts = set()   # mismatches already stated (add_once): one statement per mismatch
 
     def read(self, found):
         """Keep the ``reading`` of a deck reader's result (once); returns the result."""
@@ -28,6 +29,14 @@ class Problems:
 
     def add(self, key, message):
         self.items.append((key, message))
+
+    def add_once(self, fact, key, message):
+        """``add`` unless the same ``fact`` (a hashable naming the mismatch: e.g. the BEM file,
+        its body and what disagrees) was stated already, under this key or another (a BEM file
+        read by a coupling and two effects states its rotation centre's mismatch once)."""
+        if fact not in self.facts:
+            self.facts.add(fact)
+            self.add(key, message)
 
     def add_all(self, where, problems):
         """Record the (field, message) problems of an admissibility check as ``where.field``."""

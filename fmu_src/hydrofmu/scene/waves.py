@@ -7,6 +7,7 @@ import numpy as np
 
 from .. import keys
 from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_problems, size_problem
+from ..errors import numbers
 from .couplings import CENTRE_TOL
 
 WAVE_KEYS = keys.names(keys.WAVES)
@@ -18,7 +19,7 @@ RAMP_PERIODS = 3.0
 def read_waves(problems, table):
     """The sea state of ``[waves]`` (physics.waves.SeaState), checked; None after recording
     the problems."""
-    from ..physics.waves import SPECTRA, SeaState, WaveError
+    from ..physics.waves import SPECTRA, STRETCHING, SeaState, WaveError
     if not isinstance(table, dict):
         problems.add("waves", "expected a table [waves]")
         return None
@@ -29,7 +30,8 @@ def read_waves(problems, table):
     need = ("height", "period") if spectrum == "regular" else ("hs", "tp")
     defaults = SeaState()
     values = {}
-    for key in WAVE_KEYS - {"spectrum", "depth"}:
+    stretching = problems.choice(table, "stretching", "waves.stretching", STRETCHING, "wheeler")
+    for key in WAVE_KEYS - {"spectrum", "depth", "stretching", "points"}:
         if key in table or key not in need:
             values[key] = problems.number(table, key, f"waves.{key}", getattr(defaults, key))
         else:
@@ -40,8 +42,9 @@ def read_waves(problems, table):
         values["depth"] = math.inf
     else:
         values["depth"] = problems.number(table, "depth", "waves.depth", positive=True)
-    if None in values.values():
+    if None in values.values() or stretching is None:
         return None
+    values["stretching"] = stretching
     for key in ("components", "seed"):
         values[key] = int(values[key]) if values[key] == int(values[key]) else values[key]
     if "ramp" not in table:
@@ -58,6 +61,7 @@ def read_waves(problems, table):
 # bytes a wave component holds in a load FMU: ω, a, β, φ and k, and the transfer function's
 # six complex values per body at it (a generous bound for a few bodies)
 COMPONENT_BYTES = 8 * 5 + 16 * 6 * 4
+MAX_COMPONENTS = 10 ** 7   # physics/waves.c refuses more at initialization: said here, for both flavours
 
 
 def _plausible(problems, table, spectrum, values):
@@ -66,6 +70,9 @@ def _plausible(problems, table, spectrum, values):
     memory (an error before anything is allocated).  False after recording an error."""
     errors, warns = sea_problems(spectrum, values, getattr(problems, "env", {}).get("g", 9.81))
     too_big = size_problem(values["components"], COMPONENT_BYTES, "wave components")
+    if values["components"] > MAX_COMPONENTS and not too_big:
+        too_big = (f"{values['components']:.4g} wave components: more than {MAX_COMPONENTS:.0e}, the compiled "
+                   "FMUs' limit (each step sums them all)")
     if too_big and spectrum != "regular":
         errors.append(("components", too_big))
     for key, message in errors:
@@ -80,18 +87,68 @@ def _plausible(problems, table, spectrum, values):
     return not errors
 
 
-def check_wave_effects(problems, bodies, sea, rho, g):
+POINT_KEYS = keys.names(keys.WAVE_POINT)
+
+
+def feels_waves(effect):
+    """True for an effect that feels the incident-wave kinematics (a RIFLEX body always, an
+    AQWA drag or a DeepLines polar with ``waves = true``)."""
+    return effect.data is not None and (effect.type == "riflex_body" or bool(effect.data.get("waves")))
+
+
+def read_wave_points(problems, table, bodies):
+    """``[waves.points.NAME]``: {name: {"position": global (3)} or {"body": name, "offset": (3)}},
+    in the file's order; each name an identifier (it prefixes FMU variables)."""
+    from .problems import identifier
+    raw = table.get("points", {}) if isinstance(table, dict) else {}
+    if not isinstance(raw, dict):
+        problems.add("waves.points", "expected a table of named points [waves.points.NAME]")
+        return {}
+    points = {}
+    for name, entry in raw.items():
+        where = f"waves.points.{name}"
+        if not identifier(name):
+            problems.add(where, f"a point's name must be an identifier (it names FMU variables), found {name!r}")
+            continue
+        if not isinstance(entry, dict):
+            problems.add(where, "expected a table with position, or body and offset")
+            continue
+        problems.known_keys(entry, where, POINT_KEYS)
+        if ("position" in entry) == ("body" in entry):
+            problems.add(where, "give either position (a fixed global point) or body (and offset: a point on it)")
+            continue
+        if "position" in entry:
+            if "offset" in entry:
+                problems.add(f"{where}.offset", "offset is a point on a body: give body too, or only position")
+                continue
+            pos = problems.vector(entry, "position", f"{where}.position", 3)
+            if pos is not None:
+                points[name] = {"position": pos}
+            continue
+        body = problems.string(entry, "body", f"{where}.body")
+        offset = problems.vector(entry, "offset", f"{where}.offset", 3, [0.0, 0.0, 0.0])
+        if body is not None and body not in bodies:
+            problems.add(f"{where}.body", f"no body {body!r} in the scene (bodies: {', '.join(bodies) or 'none'})")
+            continue
+        if body is not None and offset is not None:
+            points[name] = {"body": body, "offset": offset}
+    return points
+
+
+def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
     """Checks of the BEM wave effects against the scene: rho, g, depth, rotation centres at the
     reference points (positions matter to the excitation's phase: no shift allowed), the sea
     state within every transfer function (frequencies, directions), the hydrostatics' mass,
     centre of mass and weight terms against the body's, and no restoring counted twice.
-    Fills each hydrostatics effect's equilibrium pose."""
+    Fills each hydrostatics effect's equilibrium pose.  ``feels``: something other than an
+    excitation feels the waves (kinematics: RIFLEX bodies, CONB nodes, drags with waves, points)."""
     from ..physics.kinematics import rotation
     from ..physics.waves import TransferFunction, WaveError, components
-    tfs = []
+    tfs, drifts = [], []
     for body in bodies.values():
+        _drift_problems(problems, body)
         for i, eff in enumerate(body.effects):
-            if eff.type not in ("wave_excitation", "bem_hydrostatics") or body.position is None:
+            if eff.type not in ("wave_excitation", "bem_hydrostatics", "wave_drift") or body.position is None:
                 continue
             where, d = f"bodies.{body.name}.effects[{i}]", eff.data
             name = Path(d["bem"]).name
@@ -99,15 +156,22 @@ def check_wave_effects(problems, bodies, sea, rho, g):
                    for k, v in (("rho", rho), ("g", g)) if d.get(k) is not None and v is not None
                    and abs(d[k] - v) > 1e-6 * v]
             centre = d.get("rotation_center")
+            fact = ("rotation_center", str(Path(d["bem"]).resolve()), d["body"])
             if centre is not None and np.max(np.abs(np.subtract(centre, body.position))) > CENTRE_TOL:
-                bad.append(f"rotation_center of {d['body']!r} in {name} is {centre} m but the reference point of body "
-                           f"{body.name!r} is at {body.position} m: the transfer functions are about the rotation centre "
-                           f"and their phases refer to the body's place (move the body or solve again)")
-            if eff.type == "wave_excitation":
+                # one statement per mismatch: the coupling or the other effect of this file may have made it
+                problems.add_once(fact, f"{where}.bem",
+                                  f"{Path(d['bem']).resolve()}: rotation_center[{d['body']}]: {numbers(centre)} m in the "
+                                  f"file but the reference point of scene body {body.name!r} is at "
+                                  f"{numbers(body.position)} m (bodies.{body.name}.position): the coefficients are about "
+                                  f"the rotation centre and the wave phases refer to the body's place (move the body "
+                                  f"there, or solve again about its reference point)")
+            if eff.type in ("wave_excitation", "wave_drift"):
                 mismatch = depth_mismatch(d.get("water_depth"), sea.depth if sea is not None else None)
                 if mismatch:
                     bad.append(f"{mismatch} (waves.depth; {name}'s water_depth): solve again at the scene's depth, "
                                "or set waves.depth to the result's")
+                elif not bad and eff.type == "wave_drift":
+                    drifts.append((where, name, body, eff))
                 elif not bad:
                     values = np.asarray(d["re"]) + 1j * np.asarray(d["im"])
                     try:
@@ -117,24 +181,29 @@ def check_wave_effects(problems, bodies, sea, rho, g):
                     except WaveError as exc:
                         bad.append(f"{name}: {exc}")
             else:
-                bad += _hydrostatic_problems(d, body, name, rotation)
+                # a body away from the rotation centre has its centre of mass away too: said once, above
+                bad += _hydrostatic_problems(d, body, name, rotation, centre_said=fact in problems.facts)
                 d["position0"], d["attitude0"] = list(body.position or [0.0] * 3), list(body.attitude or [0.0] * 3)
             for message in bad:
                 problems.add(f"{where}.bem", message)
     if sea is None:
         for where, _, _ in tfs:
             problems.warn(where, "no [waves] in the scene: this body's wave excitation is left out of its FMU")
+        for where, _, _, _ in drifts:
+            problems.warn(where, "no [waves] in the scene: this body's wave drift is left out of its FMU")
         return
     if not tfs:
-        if not problems.items:
-            problems.warn("waves", "no body has a wave_excitation effect: the sea state acts on nothing")
+        if not problems.items and not feels:
+            problems.warn("waves", "no body has a wave_excitation effect, a RIFLEX body, a drag with waves = true or "
+                                   "named points: the sea state acts on nothing")
         return
-    lo = max(tf.window[0] for _, _, tf in tfs)
-    hi = min(tf.window[1] for _, _, tf in tfs)
+    lo = max([tf.window[0] for _, _, tf in tfs] + [e.data["omega"][0] for _, _, _, e in drifts])
+    hi = min([tf.window[1] for _, _, tf in tfs] + [e.data["omega"][-1] for _, _, _, e in drifts])
     try:
         comps = components(sea, (lo, hi))
     except WaveError as exc:
-        problems.add(f"waves.{exc.field}", f"{exc} (from {', '.join(sorted({n for _, n, _ in tfs}))})")
+        files = {n for _, n, _ in tfs} | {n for _, n, _, _ in drifts}
+        problems.add(f"waves.{exc.field}", f"{exc} (from {', '.join(sorted(files))})")
         return
     for where, name, tf in tfs:
         try:
@@ -142,12 +211,39 @@ def check_wave_effects(problems, bodies, sea, rho, g):
         except WaveError as exc:
             problems.add(f"waves.{exc.field}", f"{name} ({where}): {exc}")
             return
+    from ..assembly import body_drift
+    for where, name, body, eff in drifts:
+        try:   # the drift of these components: data within the window, QTF headings for the sea
+            body_drift(_SeaOnly(sea), body).kernel(comps, g or 9.81, sea.depth)
+        except WaveError as exc:
+            key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
+            problems.add(key, f"{name} ({where}): {exc}")
+
+
+class _SeaOnly:
+    """What body_drift reads of a scene: its waves."""
+
+    def __init__(self, waves):
+        self.waves = waves
+
+
+def _drift_problems(problems, body):
+    """A wave_drift needs the body's wave_excitation (the sea state's parameters and the
+    window live with it) and is one per body."""
+    kinds = [e.type for e in body.effects]
+    drift = [i for i, t in enumerate(kinds) if t == "wave_drift"]
+    for i in drift[1:]:
+        problems.add(f"bodies.{body.name}.effects[{i}].type", "one wave_drift per body (a second one would count "
+                                                              "the drift twice)")
+    if drift and "wave_excitation" not in kinds:
+        problems.add(f"bodies.{body.name}.effects[{drift[0]}].type", "a wave_drift needs the body's wave_excitation "
+                                                                      "effect (the first-order loads of the same sea)")
 
 
 MASS_TOL = 0.01   # relative: the BEM result's mass against the scene's
 
 
-def _hydrostatic_problems(d, body, name, rotation):
+def _hydrostatic_problems(d, body, name, rotation, centre_said=False):
     """What makes a BEM hydrostatic matrix wrong for this scene body (messages)."""
     bad = []
     if not d["weight"]:
@@ -157,10 +253,10 @@ def _hydrostatic_problems(d, body, name, rotation):
         bad.append(f"mass = {d['mass']:.6g} kg in {name} (its restoring's weight terms) but {body.mass:.6g} kg in the "
                    f"scene (bodies.{body.name}.mass)")
     com = d.get("center_of_mass")
-    if com is not None and None not in (body.position, body.attitude, body.cog):
+    if com is not None and None not in (body.position, body.attitude, body.cog) and not centre_said:
         scene_com = np.add(body.position, rotation(body.attitude) @ np.asarray(body.cog, float))
         if np.max(np.abs(scene_com - com)) > CENTRE_TOL:
-            bad.append(f"center_of_mass = {com} m in {name} but {scene_com.round(6).tolist()} m in the scene "
+            bad.append(f"center_of_mass = {numbers(com)} m in {name} but {numbers(scene_com)} m in the scene "
                        f"(bodies.{body.name}.position + cog)")
     k = np.asarray(body.stiffness if body.stiffness is not None else np.zeros((6, 6)))
     vertical = [2, 3, 4]
