@@ -257,8 +257,12 @@ def test_model_description_is_the_python_flavours(compiled, demo_build):
             files = [f.get("name") for f in cs.find("SourceFiles")]
             assert all(f"sources/{f}" in b.namelist() for f in files) and "fmi/fmu.c" in files
             assert not any(n.endswith((".py", ".pyc")) for n in b.namelist())   # no Python inside
-    for name in ("OspSystemStructure.xml", "manifest.json"):
-        assert (demo_build / name).read_text() == (compiled["moored_barge"] / name).read_text()
+    assert (demo_build / "OspSystemStructure.xml").read_text() == \
+        (compiled["moored_barge"] / "OspSystemStructure.xml").read_text()
+    import json
+    python, c = (json.loads((f / "manifest.json").read_text()) for f in (demo_build, compiled["moored_barge"]))
+    assert (python.pop("flavour"), c.pop("flavour")) == ("python", "c")   # the one line that says which
+    assert python == c
 
 
 def test_fmpy_validates_compiled_fmus_of_every_kind(compiled, wave_builds):
