@@ -55,3 +55,22 @@ def test_compiled_flavour_says_the_same(tmp_path, capfd):
     assert float(text.split("failed at t = ")[1].split(" s")[0]) == pytest.approx(crossing(CAPSIZE), abs=6.0)
     err = capfd.readouterr().err
     assert err.count("left the linear range: attitude[2] (pitch) = ") == 1, err
+
+
+def test_a_failed_run_keeps_its_rows_and_names_the_knob(tmp_path):
+    """The capsizing run above: the RunError names the constant hold as the likely cause with
+    the linear hold as the cure and the damping it takes (ω·h/4 of the dry pitch mode, computed
+    here), and carries the rows up to the failure."""
+    path = cylinder_scene(tmp_path, "constant", 0.1, 100.0, memory=False, velocity=RATE)
+    with pytest.raises(RunError) as caught:
+        _run(path, {"run.load_hold": "constant"}, ["cyl_dynamics.attitude[2]"])
+    text = str(caught.value)
+    assert 'likely cause and the knob that would have held it: [run] load_hold = "linear"' in text, text
+    from hydrofmu.scene import load_scene
+    w = load_scene(path).run["restoring_omega"]                  # the fastest dry mode of the BEM restoring
+    ds = pitch_frequency()
+    assert w >= ds * (1 - 1e-9)                                  # an upper bound of the pitch mode's
+    assert f"−{100 * w * 0.1 / 4:.2g} % of critical at {w:.3g} rad/s" in text
+    partial = caught.value.partial
+    t = float(text.split("failed at t = ")[1].split(" s")[0])
+    assert partial.time[-1] == pytest.approx(t) and np.abs(partial.values[:, 0]).max() > LINEAR_RANGE

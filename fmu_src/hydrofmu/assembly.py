@@ -53,7 +53,7 @@ class System:
     indicators: dict[str, float]
 
 
-TIMED = ("wave_excitation",)   # effects that depend on time, not motion: the load FMU drives them itself
+TIMED = ("wave_excitation", "wave_drift")   # effects of time, not motion: the load FMU drives them itself
 
 
 def body_loads(body):
@@ -63,9 +63,9 @@ def body_loads(body):
 
 
 def wave_window(scene):
-    """The frequency window [rad/s] every body's excitation covers: one set of components for
-    the whole scene (one wave field)."""
-    omegas = [e.data["omega"] for b in scene.bodies.values() for e in b.effects if e.type == "wave_excitation"]
+    """The frequency window [rad/s] every body's excitation and drift data cover: one set of
+    components for the whole scene (one wave field)."""
+    omegas = [e.data["omega"] for b in scene.bodies.values() for e in b.effects if e.type in TIMED]
     return [max(w[0] for w in omegas), min(w[-1] for w in omegas)] if omegas else None
 
 
@@ -98,6 +98,17 @@ def joint_waves(scene):
         return None
     sea = {k: v for k, v in vars(scene.waves).items() if k != "spectrum"}
     return d.Waves(None, scene.waves.spectrum, sea, wave_window(scene), kinematics=True)
+
+
+def body_drift(scene, body):
+    """description.Drift of a body, or None (no [waves] in the scene, or no drift effect)."""
+    eff = next((e for e in body.effects if e.type == "wave_drift"), None)
+    if scene.waves is None or eff is None:
+        return None
+    dat = eff.data
+    arr = {k: (np.array(dat[k], float) if k in dat else None) for k in ("directions", "values", "pairs", "re", "im")}
+    return d.Drift(eff.name, dat["method"], float(dat["cutoff"]), np.array(dat["omega"], float),
+                   np.array(body.position[:2], float), **arr)
 
 
 def initial_motion(body):
@@ -260,7 +271,8 @@ def _loads(scene, body, sides, env):
                     + (", ".join(names) or "no effects"),
         body=body.name, position=np.array(body.position, float), attitude=np.array(body.attitude, float),
         accel_mode=body.accel_mode, effects=[e for e in body.effects if e.type not in TIMED], couplings=mine,
-        environment=env, velocity=np.array(body.velocity, float), waves=waves)
+        environment=env, velocity=np.array(body.velocity, float), waves=waves,
+        drift=body_drift(scene, body) if waves is not None else None)
     return Instance(body.name, f"{scene.name}_{body.name}", "load", body.name, fmu, motion,
                     [("force", body.name, d.DynamicsBody.load_input(""))])
 

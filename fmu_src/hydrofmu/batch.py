@@ -362,11 +362,12 @@ def _check_scene_keys(batch, first):
     try:
         load_scene(batch.scene, first)
     except InputError as exc:
-        if exc.field in first:      # the knob's own value is refused by the scene: every case would be
+        unknown = getattr(exc, "unknown", {})
+        if exc.field in first and exc.field not in unknown:   # the knob's own value refused: every case's error
             raise InputError(batch.path, None, exc.field, f"value {first[exc.field]!r}: "
                                                           f"{exc.message.split('; ')[0]}") from None
         for key in first:
-            if key in getattr(exc, "unknown", {}):
+            if key in unknown:
                 parent = key.rsplit(".", 1)[0]
                 valid = [f"{parent}.{k}" for k in exc.unknown[key]]
                 raise InputError(batch.path, None, key, f"unknown knob: {batch.scene.name} has no key {key}"

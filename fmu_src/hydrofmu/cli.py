@@ -1,4 +1,4 @@
-"""Command line: ``hydrofmu build | run | tune | batch | validate | demo | bench | bem2simo`` (a thin layer
+"""Command line: ``hydrofmu build | run | tune | batch | validate | demo | bench | bem2simo | meandrift`` (a thin layer
 over the library: ``hydrofmu.build``, ``hydrofmu.run``, ``Result.to_csv``, ``Result.plot``)."""
 import argparse
 import math
@@ -450,7 +450,7 @@ def make_parser():
     k.add_argument("-o", "--out", default=Path("build") / "bench", type=Path, help="folder of the results")
     k.add_argument("--part", action="append",
                    choices=("overhead", "memory", "sweep", "growth", "floor", "native", "startup", "stability", "hold", "bem",
-                            "robust", "batch", "ecco", "longrun", "waves", "kinematics"),
+                            "robust", "batch", "ecco", "longrun", "waves", "kinematics", "drift"),
                    help="run only this part (repeatable; default: all)")
     k.add_argument("--quick", action="store_true", help="a smoke run of the cheaper parts at small sizes (about a minute of CPU; the "
                         "parts it leaves out are named), not the documented figures")
@@ -473,6 +473,22 @@ def make_parser():
                    help="WAMIT: what the file's first column is, as the run's IPEROUT wrote it (default period; "
                         "wavenumber: KL = ω²L/g with g = 9.81)")
     m.add_argument("--png", type=Path, help="quality plot: A, B rebuilt from A∞ and K against the result")
+    d = sub.add_parser("meandrift", formatter_class=fmt,
+                       help="add Capytaine's far-field mean drift to a Capytaine dataset (needs the bem-solve extra)",
+                       description="Solve the dataset's diffraction (and radiation) problems again on the body's mesh "
+                                   "with Kochin functions, check the excitation against the dataset's, and write the "
+                                   "dataset with post_pro.far_field_mean_drift_force's drift_force_surge/sway/yaw "
+                                   "(read by the wave_drift effect).")
+    d.add_argument("dataset", type=Path, help="Capytaine dataset (.nc) of one body, with its diffraction problems")
+    d.add_argument("--mesh", required=True, type=Path, help="the body's mesh (any format cpt.load_mesh reads)")
+    d.add_argument("-o", "--out", required=True, type=Path, help="dataset to write (the input plus the drift)")
+    d.add_argument("--fixed", action="store_true", help="a held body: no motions (diffraction only)")
+    d.add_argument("--ntheta", type=int, default=361, help="Kochin directions over the circle")
+    d.add_argument("--no-lid", action="store_true", help="no interior lid (irregular frequencies not removed)")
+    d.add_argument("--omega", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="only the dataset's frequencies in [LO, HI] rad/s (default: all)")
+    d.add_argument("--every", type=int, default=1, help="every N-th of those frequencies")
+    d.add_argument("--directions", nargs="+", type=float, help="only these headings [deg] of the dataset")
     return parser
 
 
@@ -578,6 +594,14 @@ def _main(argv):
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,
                         args.symmetry_tolerance, args.png, a_inf=args.a_inf, period_variable=args.period_variable)
         return _wrote(made)[1]
+    elif args.command == "meandrift":
+        from .bem_drift import add_mean_drift
+        if args.ntheta < 16:
+            raise InputError("command line", None, "--ntheta", f"at least 16 directions, found {args.ntheta}")
+        check_outputs(files=(args.out,), inputs=(args.dataset, args.mesh))
+        keep(lambda p: add_mean_drift(args.dataset, args.mesh, p, fixed=args.fixed, ntheta=args.ntheta,
+                                      lid=not args.no_lid, omega_range=args.omega, every=args.every,
+                                      directions=args.directions), args.out, _stderr)
     elif args.command == "bench":
         from .bench.run import main as bench
         check_folder(args.out)

@@ -13,6 +13,7 @@ it at instantiation.
 from __future__ import annotations
 
 import json
+import math
 import types
 import typing
 from dataclasses import dataclass, field, fields, is_dataclass
@@ -166,6 +167,46 @@ class Waves:
 
 
 @dataclass
+class Drift:
+    """A body's second-order wave drift (physics.drift) on the scene's wave field (the same
+    components as its ``Waves``): effect ``name`` (output ``<name>.force``), ``method``
+    mean | newman | qtf, ``cutoff`` [rad/s] (qtf: the largest |ω_i − ω_j| kept; inf: all),
+    ``omega`` [rad/s]; mean drift data: ``directions`` [deg] and ``values`` (nω, nβ, 6)
+    [N/m², N·m/m²]; QTF data: ``pairs`` (nP, 2) [deg] and ``re`` + i·``im`` (nω, nω, nP, 6),
+    referred to the global origin; ``position`` (x, y) [m] the body's mean position."""
+    name: str
+    method: str
+    cutoff: float
+    omega: np.ndarray
+    position: np.ndarray
+    directions: np.ndarray | None = None
+    values: np.ndarray | None = None
+    pairs: np.ndarray | None = None
+    re: np.ndarray | None = None
+    im: np.ndarray | None = None
+
+    def data(self, g, depth):
+        """physics.drift.QTF or MeanDrift of this body."""
+        from .physics.drift import QTF, MeanDrift
+        if self.pairs is not None:
+            return QTF(self.omega, [tuple(p) for p in self.pairs], self.re + 1j * self.im, self.position, g, depth)
+        return MeanDrift(self.omega, self.directions, self.values)
+
+    def kernel(self, comps, g, depth):
+        """physics.drift.DriftLoad of the components ``comps``."""
+        from .physics.drift import DriftLoad
+        return DriftLoad(self.method, comps, self.data(g, depth), self.cutoff, self.position, g, depth)
+
+    def c_params(self):
+        """drift.c's record after the output: [method (0 mean, 1 newman, 2 qtf), cutoff (−1: none),
+        x, y, the data's c_params] (the wave numbers are drift.c's, from g and depth at
+        initialization)."""
+        from .physics.drift import METHODS
+        return ([float(METHODS.index(self.method)), self.cutoff if math.isfinite(self.cutoff) else -1.0]
+                + self.position.tolist() + self.data(9.81, math.inf).c_params())
+
+
+@dataclass
 class LoadFMU:
     """Hydrodynamic loads on one body: its effects and coupling sides.  ``position``,
     ``attitude``, ``velocity``: the reference point's state at t = 0 (the motion inputs'
@@ -181,6 +222,7 @@ class LoadFMU:
     environment: Environment
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
     waves: Waves | None = None
+    drift: Drift | None = None
 
 
 @dataclass

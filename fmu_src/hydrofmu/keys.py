@@ -142,6 +142,16 @@ EFFECTS["wave_excitation"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRIN
 EFFECTS["bem_hydrostatics"] = {"deck": {}, "inline": {**BEM_EFFECT, "bem": (STRING, "hydrostatics: Capytaine dataset "
                                                                                    "(.nc) or WAMIT .hst")}}
 
+EFFECTS["wave_drift"] = {"deck": {}, "inline": {
+    **BEM_EFFECT,
+    "bem": (STRING, "drift: WAMIT .7/.8/.9 (mean), .10d/.11d/.12d (QTF) or a Capytaine dataset with the "
+                    "far-field drift (hydrofmu meandrift)"),
+    "method": (enum("mean", "newman", "qtf"), "mean drift, Newman's approximation (default) or the full "
+                                              "difference-frequency QTF (WAMIT .10d/.11d/.12d)"),
+    "cutoff": (POSITIVE, "qtf: the largest |ω_i − ω_j| kept [rad/s] (default: every pair)"),
+    "period_variable": PERIOD_VARIABLE,
+}}
+
 WAVES = {
     "spectrum": (enum("regular", "jonswap", "pierson_moskowitz"), "sea state type (default jonswap)"),
     "hs": (NONNEG, "significant wave height Hs = 4·sqrt(m0) [m] (spectra)"),

@@ -6,7 +6,8 @@ of models/ and the wave test scenes stay bounded with each hold and step.
    load FMU, initial pitch rate 0.03 rad/s), with and without the radiation memory (its
    coupling): the growth rate σ of the peaks (log-linear fit) at each hold and step, as a
    damping ratio ζ = −σ/ω, against ζ_rad (the linear hold at 0.01 s with memory) + Δζ.
-2. Every scene of models/ and the cylinder in a JONSWAP sea (Hs 2 m, Tp 9 s, 30°, no ramp) with each hold at its step and twice it: bounded (largest |attitude| under
+2. Every scene of models/ and the cylinder in a JONSWAP sea (Hs 2 m, Tp 9 s, 30°, no ramp)
+   with each hold at its step and twice it: bounded (largest |attitude| under
    90°, finite) and the largest roll/pitch, over ``stop`` seconds.
 """
 from __future__ import annotations

@@ -22,6 +22,9 @@ Parts (each also callable alone, see ``PARTS``):
   instance pool (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
+- drift: the wave drift's cost per step per method (mean, newman, qtf with and without a
+  cut-off) against the first-order kernel at 50, 200, 1000 components, and Newman's error
+  against the full QTF (``drift_cost``)
 - waves: the `waves` effect's cost per step against the pythonfmu floor for 50, 200 and
   1000 components, and per 100 components (``waves_cost``); the floating cylinder's and the
   pair's motions in regular waves next to their lightly damped resonances, long runs at
@@ -589,11 +592,22 @@ def waves_lines(rows):
     return lines
 
 
+def part_drift(out, quick):
+    from . import drift_cost
+    counts = (50, 200) if quick else drift_cost.COUNTS
+    rows = drift_cost.cost(counts, rounds=2 if quick else 5)
+    crows = drift_cost.c_cost(counts, rounds=2 if quick else 5)
+    err = drift_cost.newman_error(hours=0.5 if quick else 2.0)
+    write_csv(out / "drift.csv", [{**r, **c} for r, c in zip(rows, crows)])
+    write_csv(out / "drift_newman.csv", [err])
+    return drift_cost.lines(rows, err, crows)
+
+
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,
          "floor": part_floor, "native": part_native, "startup": part_startup, "stability": part_stability,
          "hold": part_hold,
          "bem": part_bem, "robust": part_robust, "batch": part_batch, "ecco": part_ecco, "longrun": part_longrun, "waves": part_waves,
-         "kinematics": part_kinematics}
+         "kinematics": part_kinematics, "drift": part_drift}
 
 
 # --quick without --part: the parts whose quick size costs under ~12 s of CPU each (measured

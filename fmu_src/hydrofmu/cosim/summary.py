@@ -88,6 +88,24 @@ def _row(body, quantity, dof, unit, x):
     return {"body": body, "quantity": quantity, "dof": dof, "unit": unit, **dict(zip(STATS, stats))}
 
 
+def linear_range(result, manifest) -> list[str]:
+    """One line: the largest |roll| and |pitch| of every body over the whole run [deg], and
+    whether they stayed within the range the loads assume (rigid_body.LINEAR_RANGE)."""
+    from ..physics.rigid_body import LINEAR_RANGE
+    worst = []
+    for body in sorted(manifest["dynamics"]):
+        att = np.abs(result.motion(body, "attitude", 2))
+        if att.size:
+            worst.append((body, float(np.degrees(np.nanmax(att[:, 0]))), float(np.degrees(np.nanmax(att[:, 1])))))
+    if not worst:
+        return []
+    limit = math.degrees(LINEAR_RANGE)
+    out = [f"{b} |roll| ≤ {r:.3g}°, |pitch| ≤ {p:.3g}°" for b, r, p in worst]
+    past = [b for b, r, p in worst if max(r, p) > limit]
+    return [f"linear range ({limit:g}° roll/pitch, docs/running.md): " + "; ".join(out)
+            + (f": {', '.join(past)} left it (linear_range = false)" if past else ": within it")]
+
+
 def summarize(result, transient=0.0) -> Summary:
     """The `Summary` of a Result over t ≥ ``transient`` [s]."""
     from .report import body_loads
@@ -104,6 +122,7 @@ def summarize(result, transient=0.0) -> Summary:
             rows += [_row(body, quantity, d, u, values[:, i]) for i, (d, u) in enumerate(zip(dofs, units))]
         for effect, load in body_loads(result, manifest, body).items():
             rows += [_row(body, effect, d, u, load[keep, i]) for i, (d, u) in enumerate(zip(*LOAD))]
+    notes = list(notes) + linear_range(result, manifest)
     t = result.time[keep]
     return Summary(manifest.get("scene", ""), float(t[0]) if t.size else 0.0, float(t[-1]) if t.size else 0.0,
                    int(t.size), rows, notes, manifest.get("flavour"))

@@ -324,7 +324,7 @@ def read_wamit(path, ulen, rho, g=None, variable=None):
         raise InputError(path, None, "g", "a wavenumber column needs g (> 0) to give ω")
     table, header = numeric_rows(path, ["PER", "I", "J", "A", "B"], (4, 5))
     rows = {}   # ω (0: A(0), inf: A∞) → {(I, J): (A, B)}
-    first = {}
+    first, written = {}, {}   # written: ω → the first column as the file writes it (for messages)
     for number, vals in table:
         w = wamit_omega(path, number, vals[0], variable, ulen, g)
         i, j = (_dof_index(path, number, v, name) for v, name in ((vals[1], "I"), (vals[2], "J")))
@@ -338,13 +338,14 @@ def read_wamit(path, ulen, rho, g=None, variable=None):
             raise InputError(path, number, "I J", f"duplicate ({_as_written(vals[0], variable)}, I = {i}, J = {j}) "
                                                   f"(first at line {first[key]})")
         first[key] = number
+        written.setdefault(w, _as_written(vals[0], variable))
         rows.setdefault(w, {})[(i, j)] = (vals[3], vals[4] if len(vals) == 5 else 0.0)
     omegas = sorted(w for w in rows if np.isfinite(w) and w > 0)        # increasing ω
     if len(omegas) < 3:
         raise InputError(path, None, "PER", f"{len(omegas)} finite frequencies: at least 3 needed"
                                             + ("" if table or not header else
                                                f" (the file has {len(header)} text line(s) and no numeric row)"))
-    warnings = _wamit_pairs(path, rows, omegas, first)
+    warnings = _wamit_pairs(path, rows, omegas, first, written)
     index = sorted({i for r in rows.values() for ij in r for i in ij})
     n = len(index)
     pos = {d: k for k, d in enumerate(index)}
@@ -379,7 +380,7 @@ def _dof_index(path, number, value, name):
     return int(value)
 
 
-def _wamit_pairs(path, rows, omegas, first):
+def _wamit_pairs(path, rows, omegas, first, written):
     """A pair (I, J) given at some finite frequencies (or at them but not at PER = 0) and missing
     at others is an error (a truncated or spliced file, read as zeros otherwise); pairs of
     given dofs missing at every frequency are zeros by WAMIT's rule, said as a warning."""
@@ -389,8 +390,8 @@ def _wamit_pairs(path, rows, omegas, first):
         if gap:
             i, j = gap[0]
             last = max(first[(w, *ij)] for ij in rows[w])
-            what = "the infinite-frequency rows (PER = 0)" if np.isinf(w) else f"ω = {w:.6g} rad/s"
-            raise InputError(path, last, "I J", f"{len(gap)} pair(s) given at other frequencies are missing at {what}, "
+            what = "the infinite-frequency rows (PER = 0)" if np.isinf(w) else written[w]
+            raise InputError(path, last, "I J", f"{len(gap)} pair(s) given at other periods are missing at {what}, "
                              f"first ({i}, {j}) (its rows end at line {last}): a truncated file? every period "
                              "must list the same pairs")
     dofs = sorted({i for ij in given for i in ij})

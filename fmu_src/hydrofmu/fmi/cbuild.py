@@ -31,7 +31,7 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # the FMU's C sources, relative to the package (and to the FMU's sources/ folder)
 SOURCES = ["fmi/fmu.c", "fmi/models.c", "physics/kinematics.c", "physics/current.c", "physics/viscous_drag.c",
            "physics/current_polar.c", "physics/lumped.c", "physics/joint.c", "physics/memory.c", "physics/waves.c",
-           "physics/wave_kinematics.c",
+           "physics/wave_kinematics.c", "physics/drift.c",
            "physics/hydrostatics.c", "physics/rigid.c"]
 HEADERS = ["fmi/fmu.h", "physics/kernels.h"]
 KINDS = {description.LoadFMU: 0, description.ConnectorFMU: 1, description.DynamicsFMU: 2}
@@ -106,6 +106,9 @@ def records(slave, desc) -> list[tuple[str, list[float]]]:
     if isinstance(desc, description.LoadFMU):
         if getattr(desc, "waves", None) is not None:
             recs += _waves(slave)
+        if getattr(desc, "drift", None) is not None:   # drift.c, on the components waves.c draws
+            vr = {v.name: k for k, v in slave.vars.items()}
+            recs.append(("drift", [vr[f"{desc.drift.name}.force[1]"]] + desc.drift.c_params()))
         recs += [("motion", _motion(slave.motion_inputs)), *_env(slave),
                  ("explicit", [desc.accel_mode == "explicit"]), ("total", [slave.force.start])]
         for e, out in zip(slave.loads.effects, slave.effect_force):

@@ -170,20 +170,27 @@ typedef struct {
     HfKinPoint *cache, **points;      /* the effects' scratch cache; one per named point */
     HfWater water;
     int feels, npoints, rho;          /* effects feel the water; points; rho's value reference */
+    const double *driftrec;           /* the 'drift' record after its output (NULL: no drift) */
+    int ndriftrec;
+    double *drift;                    /* drift.c's parameters (on the same components) */
 } Sea;
 
 static void sea_release(Sea *S) {
-    hf_phasors_delete(S->phasors), free(S->wave), free(S->kin), hf_kin_point_delete(S->cache);
+    hf_phasors_delete(S->phasors), free(S->wave), free(S->kin), free(S->drift), hf_kin_point_delete(S->cache);
     for (int k = 0; S->points && k < S->npoints; k++) hf_kin_point_delete(S->points[k]);
     free(S->points);
-    S->phasors = NULL, S->wave = S->kin = NULL, S->cache = NULL, S->points = NULL;
+    S->phasors = NULL, S->wave = S->kin = S->drift = NULL, S->cache = NULL, S->points = NULL;
 }
 
 /* the 'waves', 'transfer' and 'kinematics' records; -1: of the wrong size */
 static int sea_setup(Instance *inst, Sea *S) {
     const Record *w = hf_record(inst, "waves", NULL), *t = hf_record(inst, "transfer", NULL),
-                 *k = hf_record(inst, "kinematics", NULL);
-    if (!w && !t && !k) return 0;
+                 *k = hf_record(inst, "kinematics", NULL), *d = hf_record(inst, "drift", NULL);
+    if (!w && !t && !k && !d) return 0;
+    if (d) {   /* [output, Drift.c_params] */
+        if (d->n < 2 || !hf_drift_record_ok(d->v + 1, (int)d->n - 1)) return -1;
+        S->driftrec = d->v + 1, S->ndriftrec = (int)d->n - 1;
+    }
     if (!w || !t || w->n != 5 + 2 * SEA_KNOBS) return -1;
     int nw = t->n >= 7 ? ivr(t->v[5]) : -1, nb = t->n >= 7 ? ivr(t->v[6]) : -1;
     if (!((nw == 0 && nb == 0 && t->n == 7) || (nw >= 1 && nb >= 1 && t->n == 7 + nw + nb + 12 * nw * nb))) return -1;
@@ -214,6 +221,15 @@ static int sea_draw(Instance *inst, Sea *S) {
     int n = (int)S->wave[0];
     S->phasors = hf_wave_phasors(S->wave);
     if (!S->phasors) goto oom;
+    if (S->driftrec) {   /* the body's wave drift on the same components (ArraySlave._start_waves) */
+        S->drift = hf_drift_build(S->wave, S->driftrec, S->ndriftrec, v[ivr(w[2])], w[4], field, message,
+                                  sizeof message);
+        if (!S->drift) {
+            sea_release(S);
+            hf_fail(inst, "waves.%s: %s", field, message);
+            return -1;
+        }
+    }
     if (S->kinrec) {
         const double *beta = S->wave + 2 + 3 * n + 14 * n;
         S->kin = hf_kin_build(S->wave + 2, beta, n, v[ivr(w[2])], w[4], ivr(S->kinrec[0]));
@@ -302,6 +318,7 @@ typedef struct {
     EnvRefs env;
     Sea sea;                               /* the scene's waves (sea.waves NULL: none) */
     int wave_force, wave_elevation;        /* (-1: no excitation on this body) */
+    int drift_force;                       /* (-1: no wave drift) */
     Effect *effects;
     int neffects;
     Coupling *couplings;
@@ -353,6 +370,8 @@ static int load_setup(Instance *inst) {
     }
     if (sea_setup(inst, &L->sea)) goto bad;
     if (L->sea.waves) L->wave_force = ivr(L->sea.waves[0]), L->wave_elevation = ivr(L->sea.waves[1]);
+    L->drift_force = L->sea.driftrec ? ivr(L->sea.driftrec[-1]) : -1;
+    if (L->sea.driftrec && !L->sea.waves) goto bad;
     return 0;
 bad:
     hf_fail(inst, "model.bin: the load model's records are incomplete or of the wrong size");
@@ -427,6 +446,9 @@ static void load_evaluate(Instance *inst) {
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }
+    if (L->sea.waves && inst->running && L->sea.drift)   /* on the phasors advanced above */
+        hf_drift(L->sea.drift, hf_phasors_at(L->sea.phasors, inst->has_next ? inst->next_time : 0.0),
+                 hf_phasors_ramp(L->sea.phasors), v + L->drift_force);
     if (L->sea.waves && inst->running && L->sea.npoints) sea_points(inst, &L->sea, m);
     double *total = v + L->total;
     for (int i = 0; i < 6; i++) total[i] = 0.0;
@@ -435,6 +457,7 @@ static void load_evaluate(Instance *inst) {
     for (int k = 0; k < L->ncouplings; k++)
         for (int i = 0; i < 6; i++) total[i] += v[L->couplings[k].out + i];
     for (int i = 0; i < 6 && L->sea.waves && L->wave_force >= 0; i++) total[i] += v[L->wave_force + i];
+    for (int i = 0; i < 6 && L->drift_force >= 0; i++) total[i] += v[L->drift_force + i];
 }
 
 static void load_step(Instance *inst, double t, double dt) {

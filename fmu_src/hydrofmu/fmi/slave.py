@@ -543,8 +543,10 @@ class ArraySlave(Fmi2Slave):
             self.kin = WaveKinematics(comps, g, sea.depth, sea.stretching) if self.points else None
             self.water = (Water(WaveKinematics(comps, g, sea.depth, sea.stretching), self.phasors,
                                 float(self.values[self.rho])) if cfg.kinematics else None)
+            drift = getattr(self, "drift_cfg", None)   # a load FMU's wave drift: the same components
+            self.drift = drift.kernel(comps, g, sea.depth) if drift is not None else None
         except ValueError as exc:
-            self.phasors = self.wave = self.water = self.kin = None
+            self.phasors = self.wave = self.water = self.kin = self.drift = None
             raise ValueError(f"waves.{getattr(exc, 'field', 'sea state')}: {exc}") from None
 
 
@@ -584,7 +586,8 @@ class LoadSlave(ArraySlave):
         self.depends([self.force] + self.effect_force + [c["force"] for c in self.couplings], inputs)
         self.inputs = inputs
         wave_force = self._add_waves(cfg.waves)
-        self._wave_row = int(bool(wave_force))   # the output block's last row: the excitation
+        self._wave_row = int(bool(wave_force))   # the output block's rows after the couplings: the excitation,
+        wave_force = wave_force + self._add_drift(getattr(cfg, "drift", None))   # then the drift
         # every load output in one block: total, each effect, each coupling, the waves
         self._load_out = np.r_[tuple([self.force] + self.effect_force + [c["force"] for c in self.couplings]
                                      + wave_force)]
@@ -602,6 +605,17 @@ class LoadSlave(ArraySlave):
         self.finish_registration()
         self.memories = []   # set up by start_physics
         self.stale = True
+
+    def _add_drift(self, cfg):
+        """The output <name>.force of the body's wave drift (on the waves' sea state and
+        phasors); returns [the force slice] or []."""
+        self.drift, self.drift_cfg = None, cfg
+        if cfg is None:
+            return []
+        force = self.add_vector(f"{cfg.name}.force", 6, Fmi2Causality.output, LIN_ROT["force"], None,
+                                f"second-order wave drift ({cfg.method}), global axes, about the reference point")
+        self.depends([force], [])
+        return [force]
 
     def start_physics(self):
         """The couplings' retardation memories, as ``self.memories``: [(FeedthroughMemory,
@@ -639,7 +653,8 @@ class LoadSlave(ArraySlave):
                 return
         v = self.values
         ne = len(self.loads.effects)
-        out = np.zeros((1 + ne + len(self.couplings) + self._wave_row, 6))   # total, effects, couplings, waves
+        nd = self.drift_cfg is not None
+        out = np.zeros((1 + ne + len(self.couplings) + self._wave_row + nd, 6))   # total, effects, couplings, waves, drift
         if self.phasors is not None:   # the FMU's one advance of the wave phasors this step
             p = self.phasors.at(self.next_time or 0.0)
         if ne:
@@ -650,10 +665,13 @@ class LoadSlave(ArraySlave):
             out[rows] = mem.force(v[vel]).reshape(-1, 6)
         for k, mass, acc in self._explicit:
             out[k] -= mass.dot(v[acc])
-        if self.wave is not None:   # the last row: a function of time only
+        if self.wave is not None:   # a function of time only
             w = self.wave(self.next_time or 0.0)
-            out[-1] = w[:6]
+            out[1 + ne + len(self.couplings)] = w[:6]
             v[self.elevation] = w[6]
+        if self.drift is not None:   # the last row: quadratic in the ramped phasors r·p
+            r = self.phasors.ramp_factor
+            out[-1] = self.drift(p) * (r * r)
         if self.points and self.kin is not None:
             m = self.motion(self.motion_inputs) if any(b for _, b, _ in self.points) else None
             where = [m.position + m.rot @ x if on_body else x for x, on_body, _ in self.points]

@@ -112,6 +112,15 @@ int hf_phasors_load(HfPhasors *P, const double *from, size_t n);
 HfPhasors *hf_wave_phasors(const double *params);
 /* out: [F (6), elevation] at time t (advances P to t) */
 void hf_waves(const double *params, HfPhasors *P, double t, double *out);
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac);
+
+/* drift.c: the wave drift of a body on the components of hf_wave_build's parameters
+ * (physics.drift.DriftLoad), the record from Drift.c_params; per step from the shared phasors
+ * p (n (re, im) pairs, un-ramped) and the ramp r: out (6) */
+double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
+                       char *message, size_t size);
+void hf_drift(const double *params, const double *p, double r, double *out);
+int hf_drift_record_ok(const double *record, int n);
 
 /* wave_kinematics.c: Airy kinematics of the components at a point.  params [n, g, depth,
  * stretching (0 none, 1 vertical, 2 wheeler, 3 extrapolation), omega (n), k (n), cos beta (n),

@@ -177,12 +177,11 @@ static int transfer_init(Transfer *T, const double *p, double g, double depth) {
     return 0;
 }
 
-/* TransferFunction._direction_weights for one direction; -1: outside the computed ones */
-static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
-    const double *d = T->d;
-    int nb = T->nb;
+/* TransferFunction._direction_weights for one direction over the directions d (nb, sorted
+ * in [0, 360)), closed when they go round the circle; -1: outside the computed ones */
+int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac) {
     beta = wrap360(beta);
-    if (T->closed) {
+    if (closed) {
         if (beta < d[0]) beta += 360.0;   /* below the first: across the wrap from the last */
         int j = 0;   /* searchsorted(ext, beta, 'right') - 1, clipped to 0 ... nb - 1 */
         while (j < nb && (j + 1 < nb ? d[j + 1] : d[0] + 360.0) <= beta) j++;
@@ -205,6 +204,10 @@ static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, d
     double f = (beta - d[j]) / (d[j + 1] - d[j]);
     *j0 = j, *j1 = j + 1, *frac = f < 0 ? 0 : f > 1 ? 1 : f;
     return 0;
+}
+
+static int direction_weights(const Transfer *T, double beta, int *j0, int *j1, double *frac) {
+    return hf_direction_weights(T->d, T->nb, T->closed, beta, j0, j1, frac);
 }
 
 /* TransferFunction.at for one component: X (6 complex, (re, im) pairs) referred to the origin */

@@ -191,9 +191,44 @@ def _bem_hydrostatics(problems, table, where):
             "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g}
 
 
+def _wave_drift(problems, table, where):
+    """Second-order wave drift from a BEM result (WAMIT .7/.8/.9/.10d/.11d/.12d, Capytaine
+    dataset with the far-field drift): mean drift or the difference-frequency QTF of one BEM
+    body, ``method`` mean | newman | qtf; the sea state is the scene's [waves]."""
+    import math
+
+    from ..decks.drift import QTF_SUFFIXES, read_mean_drift, read_qtf
+    problems.known_keys(table, where, keys.effect_keys("wave_drift", False))
+    method = problems.choice(table, "method", f"{where}.method", ("mean", "newman", "qtf"), "newman")
+    cutoff = problems.number(table, "cutoff", f"{where}.cutoff", positive=True) if "cutoff" in table else math.inf
+    if method is None or cutoff is None:
+        return None
+    if "cutoff" in table and method != "qtf":
+        problems.add(f"{where}.cutoff", f"applies to method = \"qtf\" only (this effect's method is {method!r})")
+        return None
+    qtf = method == "qtf"
+    if qtf and not str(table.get("bem", "")).endswith(QTF_SUFFIXES):
+        problems.add(f"{where}.bem", "method = \"qtf\" needs a difference-frequency QTF: a WAMIT .10d, .11d or .12d "
+                                     "file (mean drift files hold the diagonal only: use method = \"newman\")")
+        return None
+    data, path, body = _bem_entry(problems, table, where, read_qtf if qtf else read_mean_drift)
+    if data is None:
+        return None
+    for message in data.warnings:
+        problems.warn(f"{where}.bem", message)
+    out = {"bem": str(path), "body": body, "kind": data.kind, "method": method, "cutoff": cutoff,
+           "omega": data.omega.tolist(), "rotation_center": data.rotation_centers.get(body), "rho": data.rho,
+           "g": data.g, "water_depth": data.water_depth}
+    if qtf:
+        q = data.body(body)
+        return {**out, "pairs": [list(p) for p in data.pairs], "re": q.real.tolist(), "im": q.imag.tolist()}
+    return {**out, "directions": data.directions.tolist(), "values": data.body(body).tolist()}
+
+
 # type -> (validator, default effect name)
 EFFECT_TYPES = {
     "wave_excitation": (_wave_excitation, "waves"),
+    "wave_drift": (_wave_drift, "drift"),
     "bem_hydrostatics": (_bem_hydrostatics, "hydrostatics"),
     "aqwa_viscous_drag": (_aqwa_viscous_drag, "viscous_drag"),
     "deeplines_current_polar": (_deeplines_current_polar, "current_polar"),

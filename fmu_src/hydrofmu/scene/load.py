@@ -108,7 +108,7 @@ def _load_scene(path, overrides=None):
     feels = bool(points) or bool(joints) or any(feels_waves(e) for b in bodies.values() for e in b.effects)
     check_wave_effects(p, bodies, sea, rho, g, feels)
     _check_names(p, bodies, joints, couplings)
-    if None not in (run_cfg["step"], run_cfg["stop"]):
+    if not p.items:   # defaults for what a valid scene holds (a scene with problems is refused below)
         stable_defaults(run_cfg, bodies, couplings, sea,
                         isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"], joints)
     scene = Scene(

@@ -1,5 +1,6 @@
 """The ``[run]`` table: step, stop, algorithm, load hold, presets, ECCO settings, outputs."""
 from .. import admissible, keys
+from ..errors import InputError
 
 
 RUN_DEFAULTS = {"step": 0.1, "stop": 100.0, "algorithm": "gauss-seidel", "substep": 0.01, "load_hold": "constant"}
@@ -112,7 +113,7 @@ def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False, joints=
                 m = RigidBody(body.mass, np.diag(body.inertia) if np.ndim(body.inertia) == 1 else body.inertia,
                               body.cog).mass_matrix()
                 w = natural_frequencies(m, effect.data["stiffness"])
-            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError, InputError):
                 continue
             top = max([top, *w])
         if top > 0:

@@ -144,10 +144,11 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
     excitation feels the waves (kinematics: RIFLEX bodies, CONB nodes, drags with waves, points)."""
     from ..physics.kinematics import rotation
     from ..physics.waves import TransferFunction, WaveError, components
-    tfs = []
+    tfs, drifts = [], []
     for body in bodies.values():
+        _drift_problems(problems, body)
         for i, eff in enumerate(body.effects):
-            if eff.type not in ("wave_excitation", "bem_hydrostatics") or body.position is None:
+            if eff.type not in ("wave_excitation", "bem_hydrostatics", "wave_drift") or body.position is None:
                 continue
             where, d = f"bodies.{body.name}.effects[{i}]", eff.data
             name = Path(d["bem"]).name
@@ -164,11 +165,13 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
                                   f"{numbers(body.position)} m (bodies.{body.name}.position): the coefficients are about "
                                   f"the rotation centre and the wave phases refer to the body's place (move the body "
                                   f"there, or solve again about its reference point)")
-            if eff.type == "wave_excitation":
+            if eff.type in ("wave_excitation", "wave_drift"):
                 mismatch = depth_mismatch(d.get("water_depth"), sea.depth if sea is not None else None)
                 if mismatch:
                     bad.append(f"{mismatch} (waves.depth; {name}'s water_depth): solve again at the scene's depth, "
                                "or set waves.depth to the result's")
+                elif not bad and eff.type == "wave_drift":
+                    drifts.append((where, name, body, eff))
                 elif not bad:
                     values = np.asarray(d["re"]) + 1j * np.asarray(d["im"])
                     try:
@@ -186,18 +189,21 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
     if sea is None:
         for where, _, _ in tfs:
             problems.warn(where, "no [waves] in the scene: this body's wave excitation is left out of its FMU")
+        for where, _, _, _ in drifts:
+            problems.warn(where, "no [waves] in the scene: this body's wave drift is left out of its FMU")
         return
     if not tfs:
         if not problems.items and not feels:
             problems.warn("waves", "no body has a wave_excitation effect, a RIFLEX body, a drag with waves = true or "
                                    "named points: the sea state acts on nothing")
         return
-    lo = max(tf.window[0] for _, _, tf in tfs)
-    hi = min(tf.window[1] for _, _, tf in tfs)
+    lo = max([tf.window[0] for _, _, tf in tfs] + [e.data["omega"][0] for _, _, _, e in drifts])
+    hi = min([tf.window[1] for _, _, tf in tfs] + [e.data["omega"][-1] for _, _, _, e in drifts])
     try:
         comps = components(sea, (lo, hi))
     except WaveError as exc:
-        problems.add(f"waves.{exc.field}", f"{exc} (from {', '.join(sorted({n for _, n, _ in tfs}))})")
+        files = {n for _, n, _ in tfs} | {n for _, n, _, _ in drifts}
+        problems.add(f"waves.{exc.field}", f"{exc} (from {', '.join(sorted(files))})")
         return
     for where, name, tf in tfs:
         try:
@@ -205,6 +211,33 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
         except WaveError as exc:
             problems.add(f"waves.{exc.field}", f"{name} ({where}): {exc}")
             return
+    from ..assembly import body_drift
+    for where, name, body, eff in drifts:
+        try:   # the drift of these components: data within the window, QTF headings for the sea
+            body_drift(_SeaOnly(sea), body).kernel(comps, g or 9.81, sea.depth)
+        except WaveError as exc:
+            key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
+            problems.add(key, f"{name} ({where}): {exc}")
+
+
+class _SeaOnly:
+    """What body_drift reads of a scene: its waves."""
+
+    def __init__(self, waves):
+        self.waves = waves
+
+
+def _drift_problems(problems, body):
+    """A wave_drift needs the body's wave_excitation (the sea state's parameters and the
+    window live with it) and is one per body."""
+    kinds = [e.type for e in body.effects]
+    drift = [i for i, t in enumerate(kinds) if t == "wave_drift"]
+    for i in drift[1:]:
+        problems.add(f"bodies.{body.name}.effects[{i}].type", "one wave_drift per body (a second one would count "
+                                                              "the drift twice)")
+    if drift and "wave_excitation" not in kinds:
+        problems.add(f"bodies.{body.name}.effects[{drift[0]}].type", "a wave_drift needs the body's wave_excitation "
+                                                                      "effect (the first-order loads of the same sea)")
 
 
 MASS_TOL = 0.01   # relative: the BEM result's mass against the scene's

@@ -29,8 +29,9 @@
    simulated second (initialisation excluded), spread = (max − min) / median.
 4. The choice confirmed over the run it is tuned for (``confirm``): the candidates, cheapest
    first, run over the scene's ``stop`` (or ``confirm`` seconds, with the drift check of
-   ``confirm.py``: the last quarter's error meets the tolerance too) against the reference over the same length; the first that
-   meets the tolerance there is the choice, one that does not is reported, not offered.
+   ``confirm.py``: the last quarter's error meets the tolerance too) against the reference over
+   the same length; the first that meets the tolerance there is the choice, one that does not
+   is reported, not offered.
 
 Modules, by step: ``settings`` (the knobs searched, ``Setting``, ``Point``), ``runner`` (runs in
 this process or libcosim, the error), ``search`` (reference, search, presets), ``confirm``,

@@ -1,0 +1,176 @@
+"""Cost and accuracy of the wave drift (``hydrofmu bench --part drift``).
+
+Cost: seconds per step of each drift method (``physics.drift.DriftLoad`` with its phasors
+z_k(t), in-process, no FMI) beside the first-order kernel (``physics.waves.WaveLoad``) at
+50, 200 and 1000 components of a JONSWAP sea (Hs 2 m, Tp 9 s), interleaved rounds; ``qtf``
+with every pair and with a 0.3 rad/s cut-off.
+
+Accuracy: Newman's approximation against the full QTF on the test's QTF (tests/test_drift.py:
+Q(ω1, ω2) = 8e3·(1 + 0.4·(ω1 + ω2)) + 2e3i·(ω1 − ω2) N/m² in surge, a smooth wall-like
+drift whose off-diagonal differs from √(Q11·Q22) by its growth and its imaginary part):
+the slow-drift force's std and the surge std of a moored body (natural period 100 s, 10 %
+of critical damping) in the same 2-hour record, and the rms difference of the force.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import timing
+
+COUNTS = (50, 200, 1000)
+W_LO, W_HI = 0.2, 2.4
+
+
+def bench_qtf():
+    """The test's QTF on a 45-frequency grid (a QTF object, surge only)."""
+    from ..physics.drift import QTF
+    w = np.linspace(W_LO, W_HI, 45)
+    q = np.zeros((w.size, w.size, 1, 6), complex)
+    q[:, :, 0, 0] = 8e3 * (1 + 0.4 * (w[:, None] + w[None, :])) + 2e3j * (w[:, None] - w[None, :])
+    return QTF(w, [(0.0, 0.0)], q)
+
+
+def sea(n, seed=1):
+    from ..physics.waves import SeaState, components
+    return components(SeaState(hs=2.0, tp=9.0, components=n, seed=seed), (W_LO, W_HI))
+
+
+def cost(counts=COUNTS, calls=300, rounds=5):
+    """Rows per component count: µs per step of waves (first order), mean, newman, qtf with
+    a 0.3 rad/s cut-off and qtf with every pair (phasors included)."""
+    from ..physics.drift import DriftLoad, phasors
+    from ..physics.waves import TransferFunction, WaveLoad
+    data = bench_qtf()
+    flat = TransferFunction(data.omega, [0.0], np.ones((data.omega.size, 1, 6), complex))
+    rows = []
+    for n in counts:
+        comps = sea(n)
+        loads = {"waves": WaveLoad(comps, flat, (0.0, 0.0))}
+        for label, method, cut in (("mean", "mean", math.inf), ("newman", "newman", math.inf),
+                                   ("qtf_cut", "qtf", 0.3), ("qtf", "qtf", math.inf)):
+            loads[label] = DriftLoad(method, comps, data, cut)
+        dt = 0.05
+
+        def make(label):
+            load = loads[label]
+            if label == "waves":
+                return lambda: (lambda k: load(dt * k))
+            return lambda: (lambda k: load(phasors(comps, dt * k)))
+        got = timing.per_round({label: make(label) for label in loads}, max(20, calls // (1 + n // 200)), rounds)
+        per = {k: float(np.median(v)) for k, v in got.items()}
+        row = {"components": n, **{f"{k}_us": 1e6 * v for k, v in per.items()},
+               "qtf_cut_offsets": loads["qtf_cut"].offsets, "noisy": noisy(got)}
+        row.update({f"{k}_x_waves": per[k] / per["waves"] for k in loads if k != "waves"})
+        rows.append(row)
+    return rows
+
+
+def noisy(times, limit=0.25):
+    """True when a candidate's rounds spread by more than ``limit`` of their median (a busy
+    machine: the ratios are then not to be trusted)."""
+    return any((max(v) - min(v)) > limit * float(np.median(v)) for v in times.values())
+
+
+def c_cost(counts=COUNTS, rounds=5, steps=2000):
+    """Rows per component count: µs per step of the compiled kernels, each with the shared
+    phasors' advance (physics/waves.c's hf_waves; physics/drift.c's hf_drift per method),
+    timed in a C loop (bench/drift_timing.c), median of interleaved rounds."""
+    import ctypes
+    from pathlib import Path
+    from ..cc import cached_many
+    from ..description import Drift
+    from ..physics.waves import TransferFunction
+    here = Path(__file__).resolve().parent
+    lib = ctypes.CDLL(str(cached_many([here.parent / "physics" / "waves.c", here.parent / "physics" / "drift.c",
+                                       here / "drift_timing.c"], "drift_bench", libs=["-lm"],
+                                      flags=["-O3", "-shared", "-fPIC", "-std=c99"])))
+    lib.hf_wave_build.restype = ctypes.POINTER(ctypes.c_double)
+    lib.hf_drift_build.restype = ctypes.POINTER(ctypes.c_double)
+    lib.hf_bench_per_call.restype = ctypes.c_double
+    lib.hf_bench_per_call.argtypes = [ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double), ctypes.c_int,
+                                      ctypes.c_double]
+
+    class Sea(ctypes.Structure):
+        _fields_ = [("spectrum", ctypes.c_int)] + [(k, ctypes.c_double) for k in (
+            "height", "period", "phase", "hs", "tp", "gamma", "direction", "spreading", "components", "seed", "ramp",
+            "depth")]
+    data = bench_qtf()
+    flat = TransferFunction(data.omega, [0.0], np.ones((data.omega.size, 1, 6), complex)).c_params(data.window)
+    pairs = np.array([[0.0, 0.0]])
+    q = data.grid[:, :, 0, 0][:, :, None, :]
+    rows = []
+    for n in counts:
+        sea = Sea(1, 0.0, 10.0, 0.0, 2.0, 9.0, 3.3, 0.0, 0.0, float(n), 1.0, 0.0, math.inf)
+        f, m = ctypes.create_string_buffer(16), ctypes.create_string_buffer(400)
+        wave = lib.hf_wave_build(ctypes.byref(sea), (ctypes.c_double * len(flat))(*flat), ctypes.c_double(9.81), f, m,
+                                 ctypes.c_size_t(400))
+        params = {"waves": wave}
+        for label, method, cut in (("mean", "mean", math.inf), ("newman", "newman", math.inf),
+                                   ("qtf_cut", "qtf", 0.3), ("qtf", "qtf", math.inf)):
+            if method == "qtf":
+                rec = Drift("drift", method, cut, data.omega, np.zeros(2), pairs=pairs, re=q.real, im=q.imag).c_params()
+            else:
+                mean = data.diagonal()
+                rec = Drift("drift", method, cut, mean.omega, np.zeros(2), directions=mean.table.directions,
+                            values=mean.table.values.real).c_params()
+            p = lib.hf_drift_build(wave, (ctypes.c_double * len(rec))(*rec), len(rec), ctypes.c_double(9.81),
+                                   ctypes.c_double(math.inf), f, m, ctypes.c_size_t(400))
+            assert p, m.value
+            params[label] = p
+        calls = max(50, steps // (1 + n // 100))
+        times = {k: [] for k in params}
+        for _ in range(rounds):
+            for k, p in params.items():
+                times[k].append(lib.hf_bench_per_call(wave, None if k == "waves" else p, calls, 0.05))
+        per = {k: float(np.median(v)) for k, v in times.items()}
+        row = {"components": n, **{f"c_{k}_us": 1e6 * v for k, v in per.items()}, "c_noisy": noisy(times)}
+        row.update({f"c_{k}_x_waves": per[k] / per["waves"] for k in per if k != "waves"})
+        rows.append(row)
+        for p in params.values():
+            ctypes.CDLL(None).free(p)
+    return rows
+
+
+def newman_error(n=200, hours=2.0, dt=2.0):
+    """Newman against the full QTF in one record: {force_std_ratio, force_rms_error (of the
+    QTF's std), surge_std_ratio, mean_ratio} (Newman / QTF)."""
+    from scipy.signal import lsim
+    from ..physics.drift import DriftLoad, phasors
+    data = bench_qtf()
+    comps = sea(n, seed=7)
+    full, newman = DriftLoad("qtf", comps, data), DriftLoad("newman", comps, data)
+    t = np.arange(0.0, hours * 3600.0, dt)
+    fq = np.empty(t.size)
+    fn = np.empty(t.size)
+    for k, s in enumerate(t):
+        z = phasors(comps, s)
+        fq[k], fn[k] = full(z)[0], newman(z)[0]
+    mass, period, zeta = 2.0e6, 100.0, 0.1
+    wn = 2 * math.pi / period
+    system = ([1.0], [mass, 2 * zeta * mass * wn, mass * wn ** 2])
+    settle = t > 10 / (zeta * wn)
+    xq = lsim(system, fq, t)[1][settle]
+    xn = lsim(system, fn, t)[1][settle]
+    return {"components": n, "record_h": hours, "mean_ratio": fn.mean() / fq.mean(),
+            "force_std_ratio": fn.std() / fq.std(), "force_rms_error": float(np.sqrt(np.mean((fn - fq) ** 2)) / fq.std()),
+            "surge_std_ratio": xn.std() / xq.std()}
+
+
+def lines(rows, err, crows=None):
+    """The part's summary lines; '(noisy)': the rounds of that count spread by more than 25 %."""
+    out = ["cost per step in-process (phasors included), × the first-order waves kernel: " + "; ".join(
+        f"{r['components']} components: waves {r['waves_us']:.0f} µs, mean {r['mean_x_waves']:.2f}×, newman "
+        f"{r['newman_x_waves']:.2f}×, qtf cut 0.3 rad/s ({r['qtf_cut_offsets']} offsets) {r['qtf_cut_x_waves']:.1f}×, "
+        f"qtf all pairs {r['qtf_x_waves']:.1f}×" + (" (noisy)" if r["noisy"] else "") for r in rows)]
+    if crows:
+        out.append("compiled kernels (physics/drift.c against waves.c's hf_waves, a C loop): " + "; ".join(
+            f"{r['components']} components: waves {r['c_waves_us']:.2f} µs, mean {r['c_mean_x_waves']:.2f}×, newman "
+            f"{r['c_newman_x_waves']:.2f}×, qtf cut 0.3 rad/s {r['c_qtf_cut_x_waves']:.1f}×, qtf all pairs "
+            f"{r['c_qtf_x_waves']:.1f}×" + (" (noisy)" if r["c_noisy"] else "") for r in crows))
+    out.append(f"Newman against the full QTF (test QTF, {err['components']} components, {err['record_h']:g} h): mean "
+               f"{err['mean_ratio']:.3f}, slow-drift force std {err['force_std_ratio']:.3f}, rms difference "
+               f"{100 * err['force_rms_error']:.0f} % of the QTF force's std, moored surge std (100 s, 10 % damping) "
+               f"{err['surge_std_ratio']:.3f}")
+    return out
