@@ -149,13 +149,14 @@ def round_off(curves, scale, floor=0.0):
     """The largest |value| of ``curves`` [(effect, component, values)] when it is no more than
     ``ROUND_OFF`` of ``scale`` (the largest value of the same kind on the body) or than
     ``floor`` (an absolute bound), and not zero: the panel holds round-off only.  Else None."""
-    peak = max((float(np.nanmax(np.abs(y))) for _, _, y in curves if np.size(y)), default=0.0)
+    peak = _peak(curves)
     if not np.isfinite(peak) or peak == 0.0:
         return None
     return peak if peak <= max(ROUND_OFF * scale, floor) else None
 
 
 def _peak(curves):
+    """The largest |value| of (effect, component, values) curves (0 when there are none)."""
     return max((float(np.nanmax(np.abs(y))) for _, _, y in curves if np.size(y)), default=0.0)
 
 
