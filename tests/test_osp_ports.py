@@ -84,7 +84,8 @@ EXTRA = """
     """
 ALL = SCENES + ["earth_explicit"]
 # counted by hand from the scene files: bonds (load or joint side, dynamics side) per scene
-BONDS = {"moored_barge": 1, "side_by_side": 2, "joined_barges": 4, "earth_explicit": 5}
+BONDS = {"moored_barge": 1, "side_by_side": 2, "joined_barges": 4, "earth_explicit": 5, "buoy_in_waves": 1,
+         "moored_cylinder": 1}
 
 
 @pytest.fixture(scope="module")
