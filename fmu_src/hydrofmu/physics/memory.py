@@ -223,15 +223,18 @@ class Convolution:
         c = length / 6.0
         fa, fb = c * (2 * la + lb), c * (la + 2 * lb)              # far node (k + 1)
         na, nb = c * (2 * (1 - la) + 1 - lb), c * (1 - la + 2 * (1 - lb))  # near node (k)
-        from scipy import sparse   # here, not at import: FMUs with state-space memory never need it
         cols = np.concatenate([j, j + hl.shape[0]])
 
-        def part(rows, at_a, at_b):   # S·[hl; hr], S sparse (node × segment end)
+        # S·[hl; hr] summed row by row with numpy alone (no scipy.sparse: an FMU's Python
+        # needs numpy only, and a host whose steps are not all equal comes here every step)
+        def part(rows, at_a, at_b):
             data = np.concatenate([(1 - aa) * at_a + (1 - ab) * at_b, aa * at_a + ab * at_b])
-            return sparse.csr_matrix((data, (np.concatenate([rows, rows]), cols)), shape=(s.size, 2 * hl.shape[0]))
+            out = np.zeros((s.size, self._h2.shape[1]))
+            np.add.at(out, np.concatenate([rows, rows]), data[:, None] * self._h2[cols])
+            return out
         if halves:
-            return part(k, na, nb) @ self._h2, part(k + 1, fa, fb) @ self._h2
-        return (part(k, na, nb) + part(k + 1, fa, fb)) @ self._h2
+            return part(k, na, nb), part(k + 1, fa, fb)
+        return part(k, na, nb) + part(k + 1, fa, fb)
 
     C_TAG = "convolution"   # its record in a compiled FMU (memory.c)
 
