@@ -133,13 +133,15 @@ def c_cost(counts=COUNTS, rounds=5, steps=2000):
     return rows
 
 
-def newman_error(n=200, hours=2.0, dt=2.0):
+def newman_error(n=200, hours=2.0, dt=2.0, data=None):
     """Newman against the full QTF in one record: {force_std_ratio, force_rms_error (of the
-    QTF's std), surge_std_ratio, mean_ratio} (Newman / QTF)."""
+    QTF's std), surge_std_ratio, mean_ratio} (Newman / QTF, surge); ``data``: a
+    physics.drift.QTF (default the test QTF), long-crested along its first heading."""
     from scipy.signal import lsim
     from ..physics.drift import DriftLoad, phasors
-    data = bench_qtf()
+    data = data if data is not None else bench_qtf()
     comps = sea(n, seed=7)
+    comps.direction[:] = data.headings[0]
     full, newman = DriftLoad("qtf", comps, data), DriftLoad("newman", comps, data)
     t = np.arange(0.0, hours * 3600.0, dt)
     fq = np.empty(t.size)
