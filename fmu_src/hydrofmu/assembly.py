@@ -103,12 +103,7 @@ def joint_waves(scene):
 def body_drift(scene, body):
     """description.Drift of a body, or None (no [waves] in the scene, or no drift effect)."""
     eff = next((e for e in body.effects if e.type == "wave_drift"), None)
-    if scene.waves is None or eff is None:
-        return None
-    dat = eff.data
-    arr = {k: (np.array(dat[k], float) if k in dat else None) for k in ("directions", "values", "pairs", "re", "im")}
-    return d.Drift(eff.name, dat["method"], float(dat["cutoff"]), np.array(dat["omega"], float),
-                   np.array(body.position[:2], float), **arr)
+    return None if scene.waves is None or eff is None else d.Drift.of(eff, body.position)
 
 
 def initial_motion(body):

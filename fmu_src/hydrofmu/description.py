@@ -185,6 +185,14 @@ class Drift:
     re: np.ndarray | None = None
     im: np.ndarray | None = None
 
+    @classmethod
+    def of(cls, effect: Effect, position) -> "Drift":
+        """The Drift of a scene body's ``wave_drift`` effect, the body at ``position`` [m]."""
+        dat = effect.data
+        arr = {k: (np.array(dat[k], float) if k in dat else None) for k in ("directions", "values", "pairs", "re", "im")}
+        return cls(effect.name, dat["method"], float(dat["cutoff"]), np.array(dat["omega"], float),
+                   np.array(position[:2], float), **arr)
+
     def data(self, g, depth):
         """physics.drift.QTF or MeanDrift of this body."""
         from .physics.drift import QTF, MeanDrift

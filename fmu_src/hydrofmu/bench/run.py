@@ -165,10 +165,10 @@ def part_sweep(out, quick):
     write_csv(out / "step_sweep.csv", rows)
     fig, ax = plt.subplots(figsize=(7, 5))
     for alg in ("jacobi", "gauss-seidel"):
-        for hold in ("constant", "linear"):
-            rs = [r for r in rows if r["algorithm"] == alg and r["load_hold"] == hold]
+        for kind in ("constant", "linear"):
+            rs = [r for r in rows if r["algorithm"] == alg and r["load_hold"] == kind]
             ax.loglog([r["wall_s"] for r in rs], [r["error"] for r in rs], "o-" if alg != "jacobi" else "s--",
-                      label=f"{alg}, {hold} hold")
+                      label=f"{alg}, {kind} hold")
     rs = sorted((r for r in rows if r["algorithm"] == "ecco"), key=lambda r: r["wall_s"])
     ax.loglog([r["wall_s"] for r in rs], [r["error"] for r in rs], "D-", color="C4",
               label="ECCO (libcosim), linear hold")

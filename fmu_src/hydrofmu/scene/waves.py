@@ -7,6 +7,7 @@ import numpy as np
 
 from .. import keys
 from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_problems, size_problem
+from ..description import Drift
 from ..errors import numbers
 from .couplings import CENTRE_TOL
 
@@ -211,20 +212,12 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
         except WaveError as exc:
             problems.add(f"waves.{exc.field}", f"{name} ({where}): {exc}")
             return
-    from ..assembly import body_drift
     for where, name, body, eff in drifts:
         try:   # the drift of these components: data within the window, QTF headings for the sea
-            body_drift(_SeaOnly(sea), body).kernel(comps, g or 9.81, sea.depth)
+            Drift.of(eff, body.position).kernel(comps, g or 9.81, sea.depth)
         except WaveError as exc:
             key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
             problems.add(key, f"{name} ({where}): {exc}")
-
-
-class _SeaOnly:
-    """What body_drift reads of a scene: its waves."""
-
-    def __init__(self, waves):
-        self.waves = waves
 
 
 def _drift_problems(problems, body):
