@@ -80,6 +80,16 @@ class BemData:
             return None
 
 
+def body_dofs(values, dofs, name):
+    """``values[..., c]`` of the columns c whose (body, k) is body ``name``, spread over its
+    6 dofs (k = 1…6); zero for the dofs the file leaves out."""
+    out = np.zeros(values.shape[:-1] + (6,), values.dtype)
+    for c, (b, k) in enumerate(dofs):
+        if b == name:
+            out[..., k - 1] = values[..., c]
+    return out
+
+
 def read_bem(path, ulen=None, rho=None, g=None, period_variable=None):
     """Read a Capytaine dataset (.nc) or a WAMIT .1 file (by its extension); ``ulen``,
     ``rho``, ``g`` and ``period_variable`` (what the first column is) apply to WAMIT."""

@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .bem import DOF_NAMES, _single_name, check_scalar, period_variable, wamit_omega
+from .bem import DOF_NAMES, _single_name, body_dofs, check_scalar, period_variable, wamit_omega
 from .lines import Reading, numeric_rows
 
 
@@ -66,11 +66,7 @@ class ExcitationData:
 
     def body(self, name):
         """(nω, nβ, 6) complex of one body, zero for dofs the file leaves out."""
-        out = np.zeros(self.values.shape[:2] + (6,), complex)
-        for c, (b, k) in enumerate(self.dofs):
-            if b == name:
-                out[:, :, k - 1] = self.values[:, :, c]
-        return out
+        return body_dofs(self.values, self.dofs, name)
 
 
 @dataclass

@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .bem import period_variable as _variable, wamit_omega
+from .bem import body_dofs, period_variable as _variable, wamit_omega
 from .lines import numeric_rows
 
 MEAN_SUFFIXES = (".7", ".8", ".9")
@@ -91,11 +91,7 @@ class MeanDriftData:
 
     def body(self, name):
         """(nω, nβ, 6) real of one body, zero for dofs the file leaves out."""
-        out = np.zeros(self.values.shape[:2] + (6,))
-        for c, (b, k) in enumerate(self.dofs):
-            if b == name:
-                out[:, :, k - 1] = self.values[:, :, c]
-        return out
+        return body_dofs(self.values, self.dofs, name)
 
 
 @dataclass
@@ -120,11 +116,7 @@ class QTFData:
 
     def body(self, name):
         """(nω, nω, nP, 6) complex of one body, zero for dofs the file leaves out."""
-        out = np.zeros(self.values.shape[:3] + (6,), complex)
-        for c, (b, k) in enumerate(self.dofs):
-            if b == name:
-                out[..., k - 1] = self.values[..., c]
-        return out
+        return body_dofs(self.values, self.dofs, name)
 
     def mean(self) -> MeanDriftData:
         """The diagonal (ω_i = ω_j, β1 = β2): the mean drift, real by the conjugate symmetry."""
