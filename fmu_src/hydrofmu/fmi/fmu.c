@@ -58,25 +58,27 @@ static void say(Instance *inst, fmi2Status status, const char *category, const c
     if (logger) logger(inst->env, inst->name ? inst->name : "", status, category, escaped);
 }
 
-void hf_fail(Instance *inst, const char *fmt, ...) {
+/* "<instance>: <message>" to the host's logger */
+static void vsay(Instance *inst, fmi2Status status, const char *category, const char *fmt, va_list ap) {
     char text[1024];
     int at = snprintf(text, sizeof text, "%s: ", inst->name ? inst->name : "");
+    vsnprintf(text + at, sizeof text - at, fmt, ap);
+    say(inst, status, category, text);
+}
+
+void hf_fail(Instance *inst, const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(text + at, sizeof text - at, fmt, ap);
+    vsay(inst, fmi2Error, "logStatusError", fmt, ap);
     va_end(ap);
-    say(inst, fmi2Error, "logStatusError", text);
     inst->status = fmi2Error;
 }
 
 void hf_warn(Instance *inst, const char *fmt, ...) {
-    char text[1024];
-    int at = snprintf(text, sizeof text, "%s: ", inst->name ? inst->name : "");
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(text + at, sizeof text - at, fmt, ap);
+    vsay(inst, fmi2Warning, "logStatusWarning", fmt, ap);
     va_end(ap);
-    say(inst, fmi2Warning, "logStatusWarning", text);
 }
 
 void hf_set_error(Instance *inst, const char *fmt, ...) {

@@ -521,6 +521,21 @@ class ArraySlave(Fmi2Slave):
         self.depends([force, slice(self.elevation, self.elevation + 1)], [])
         return [force]
 
+    def _ready(self):
+        """Whether an evaluation may go on: its inputs finite (checked when one set since the
+        last check may not be) and its sea started; False after setting ``self.error``."""
+        if self.suspect:
+            if not self.check_finite(self.inputs):
+                return False
+            self.suspect = False
+        if self.wave_cfg is not None and self.phasors is None and self.running:
+            try:   # (initialization failed on the sea state: no step goes on without its waves)
+                self._start_waves()
+            except ValueError as exc:
+                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
+                return False
+        return True
+
     def _start_waves(self):
         """The phasors, excitation and kinematics of the sea state the waves.* parameters hold
         now (one error naming the knob when they are not a usable sea state)."""
@@ -641,16 +656,8 @@ class LoadSlave(ArraySlave):
 
     def evaluate(self):
         self.stale = self.checked = False
-        if self.suspect:   # an input set since the last check may be non-finite
-            if not self.check_finite(self.inputs):
-                return
-            self.suspect = False
-        if self.wave_cfg is not None and self.phasors is None and self.running:
-            try:   # (initialization failed on the sea state: no step goes on without its waves)
-                self._start_waves()
-            except ValueError as exc:
-                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
-                return
+        if not self._ready():
+            return
         v = self.values
         ne = len(self.loads.effects)
         nd = self.drift_cfg is not None
@@ -892,16 +899,8 @@ class ConnectorSlave(ArraySlave):
 
     def evaluate(self):
         self.stale = False
-        if self.suspect:   # an input set since the last check may be non-finite
-            if not self.check_finite(self.inputs):
-                return
-            self.suspect = False
-        if self.wave_cfg is not None and self.phasors is None and self.running:
-            try:   # (initialization failed on the sea state: no step goes on without its waves)
-                self._start_waves()
-            except ValueError as exc:
-                self.error = f"the waves.* parameters are not a usable sea state ({exc})"
-                return
+        if not self._ready():
+            return
         env = self.env()
         if self.phasors is not None:
             self.phasors.at(self.next_time or 0.0)
