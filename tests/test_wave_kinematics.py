@@ -29,8 +29,10 @@ def airy(comps, t, x, y, z, depth, r=1.0):
         b = math.radians(beta)
         th = w * t - k * (x * math.cos(b) + y * math.sin(b)) + phi
         c, s = math.cos(th), math.sin(th)
-        out += [w * a * fh * c * math.cos(b), w * a * fh * c * math.sin(b), w * a * fv * s,
-                -w * w * a * fh * s * math.cos(b), -w * w * a * fh * s * math.sin(b), w * w * a * fv * c,
+        # η = a cos θ; the vertical velocity is ∂η/∂t = −aω sin θ at z = 0 (kinematic surface
+        # condition) times F_v, and its time derivative −aω² cos θ·F_v
+        out += [w * a * fh * c * math.cos(b), w * a * fh * c * math.sin(b), -w * a * fv * s,
+                -w * w * a * fh * s * math.cos(b), -w * w * a * fh * s * math.sin(b), -w * w * a * fv * c,
                 RHO * G * a * fp * c, a * c]
     return out
 
@@ -81,7 +83,7 @@ def test_stretching_at_a_crest_by_hand(depth):
         fv = lambda z: math.sinh(k * (z + h)) / math.sinh(k * h)    # noqa: E731
         fh0, dfh = 1 / math.tanh(k * h), k
         fv0, dfv = 1.0, k / math.tanh(k * h)
-    # at the crest: u = ω a F_h, w = 0, a_x = 0, a_z = ω² a F_v
+    # at the crest: u = ω a F_h, w = 0, a_x = 0, a_z = −ω² a F_v (the water decelerates downward)
     for z in (1.0, -3.0):
         wheeler_z = z - a if math.isinf(depth) else h * (z - a) / (h + a)
         want = {"none": (fh(z), fv(z)),
@@ -91,7 +93,7 @@ def test_stretching_at_a_crest_by_hand(depth):
         for name, (h_, v_) in want.items():
             row = WaveKinematics(comps, G, depth, name).at(p, 1.0, [(0.0, 0.0, z)])[0]
             assert row[0] == pytest.approx(w * a * h_, rel=1e-12), (name, z)
-            assert row[5] == pytest.approx(w * w * a * v_, rel=1e-12), (name, z)
+            assert row[5] == pytest.approx(-w * w * a * v_, rel=1e-12), (name, z)
             assert abs(row[2]) < 1e-12 and abs(row[3]) < 1e-12 and row[7] == pytest.approx(a, rel=1e-14)
     # Wheeler at the surface itself: the z = 0 values; above it, out of the water
     row = WaveKinematics(comps, G, depth, "wheeler").at(p, 1.0, [(0.0, 0.0, a)])[0]

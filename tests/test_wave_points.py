@@ -65,8 +65,9 @@ def airy_regular(t, x, y, z, a=1.0, period=8.0, beta=30.0, phi=20.0, depth=math.
     b = math.radians(beta)
     th = w * t - k * (x * math.cos(b) + y * math.sin(b)) + math.radians(phi)
     c, s = math.cos(th), math.sin(th)
-    return np.array([w * a * fh * c * math.cos(b), w * a * fh * c * math.sin(b), w * a * fv * s,
-                     -w * w * a * fh * s * math.cos(b), -w * w * a * fh * s * math.sin(b), w * w * a * fv * c,
+    # w = ∂η/∂t·F_v (η = a cos θ): −aω sin θ·F_v; a_z its time derivative
+    return np.array([w * a * fh * c * math.cos(b), w * a * fh * c * math.sin(b), -w * a * fv * s,
+                     -w * w * a * fh * s * math.cos(b), -w * w * a * fh * s * math.sin(b), -w * w * a * fv * c,
                      RHO * G * a * fp * c, a * c])
 
 

@@ -101,8 +101,8 @@ void hf_kin_at(const double *params, HfKinPoint *c, const double *p, double r, c
         double pr = p[2 * k], pi = p[2 * k + 1], er = c->e[2 * k], ei = c->e[2 * k + 1];
         double re = pr * er - pi * ei, im = pr * ei + pi * er, wk = w[k], w2 = wk * wk;
         double hre = c->fh[k] * re, him = c->fh[k] * im;
-        u0 += wk * cb[k] * hre, u1 += wk * sb[k] * hre, u2 += wk * c->fv[k] * im;
-        a0 -= w2 * cb[k] * him, a1 -= w2 * sb[k] * him, a2 += w2 * c->fv[k] * re;
+        u0 += wk * cb[k] * hre, u1 += wk * sb[k] * hre, u2 -= wk * c->fv[k] * im;   /* w = dη/dt at z = 0 */
+        a0 -= w2 * cb[k] * him, a1 -= w2 * sb[k] * him, a2 -= w2 * c->fv[k] * re;
         pd += c->fp[k] * re;
     }
     out[0] = r * u0, out[1] = r * u1, out[2] = r * u2, out[3] = r * a0, out[4] = r * a1, out[5] = r * a2;

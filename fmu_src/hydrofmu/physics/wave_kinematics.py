@@ -9,11 +9,12 @@ one wave field (physics/waves.py ``Components``) and their per-step phasors p_k 
 (``waves.Phasors``, shared with the excitation), ramped: z_k = r(t)·p_k.  At a point (x, y, z)
 
     E_k = z_k·e^{−i k_k (x cos β_k + y sin β_k)}          (η = Σ Re E_k, in phase with the elevation)
-    velocity      u_h = Σ ω_k·F_h,k(z)·Re E_k·(cos β_k, sin β_k)      w = Σ ω_k·F_v,k(z)·Im E_k
-    acceleration  a_h = −Σ ω_k²·F_h,k(z)·Im E_k·(cos β_k, sin β_k)   a_z = Σ ω_k²·F_v,k(z)·Re E_k
+    velocity      u_h = Σ ω_k·F_h,k(z)·Re E_k·(cos β_k, sin β_k)      w = −Σ ω_k·F_v,k(z)·Im E_k
+    acceleration  a_h = −Σ ω_k²·F_h,k(z)·Im E_k·(cos β_k, sin β_k)   a_z = −Σ ω_k²·F_v,k(z)·Re E_k
     dynamic pressure  p_d = ρ·g·Σ F_p,k(z)·Re E_k          (total pressure p_d − ρ·g·z)
 
-(local acceleration ∂u/∂t, linear theory), with the depth factors (depth h, ω² = g k tanh kh)
+(local acceleration ∂u/∂t, linear theory: ∂η/∂t = −Σ ω_k·Im E_k, so w(0) = ∂η/∂t, the water rising
+under a rising surface, and a_z < 0 under a crest), with the depth factors (depth h, ω² = g k tanh kh)
 
     F_h = cosh k(z+h) / sinh kh,  F_v = sinh k(z+h) / sinh kh,  F_p = cosh k(z+h) / cosh kh
     deep water (h = inf): F_h = F_v = F_p = e^{kz}
@@ -75,7 +76,7 @@ class WaveKinematics:
         re, im = np.arange(0, 2 * n, 2), np.arange(1, 2 * n, 2)
         w[re, 0], w[re, 1] = self.omega * self.cos, self.omega * self.sin          # u_h: ω F_h Re E
         w[im, 3], w[im, 4] = -self.w2 * self.cos, -self.w2 * self.sin              # a_h: −ω² F_h Im E
-        w[2 * n + im, 2], w[2 * n + re, 5] = self.omega, self.w2                   # w, a_z: F_v
+        w[2 * n + im, 2], w[2 * n + re, 5] = -self.omega, -self.w2                 # w, a_z: −F_v (w = ∂η/∂t at 0)
         w[4 * n + re, 6] = 1.0                                                    # p_d / ρg: F_p Re E
         w[6 * n + re, 7] = 1.0                                                    # η
         self.weights = w
