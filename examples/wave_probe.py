@@ -83,7 +83,8 @@ def airy(comps, t, x, y, z, g=9.81, ramp=20.0):
     r = 0.5 * (1 - math.cos(math.pi * t / ramp)) if t < ramp else 1.0
     eta = r * np.sum(comps.amplitude * np.cos(th))
     e = r * comps.omega * comps.amplitude * np.exp(k * (z - eta))
-    return np.array([np.sum(e * np.cos(th) * np.cos(b)), np.sum(e * np.cos(th) * np.sin(b)), np.sum(e * np.sin(th))])
+    # w = ∂η/∂t (times the depth factor): −Σ ω a sin θ, the water rising under a rising surface
+    return np.array([np.sum(e * np.cos(th) * np.cos(b)), np.sum(e * np.cos(th) * np.sin(b)), -np.sum(e * np.sin(th))])
 
 
 def main(argv=None):
