@@ -733,11 +733,12 @@ def rss_kb():
         return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:"))
 
 
-def test_million_steps_memory_flat(tmp_path):
-    """10⁶ steps (62 500 s) through a load FMU with a convolution memory: every 1000 steps
-    the output is finite and the FMU's evaluator holds ≤ span/dt + 2 velocity nodes; at
-    10 %, 50 % and 100 % the load equals the exact integral over the window and the process
-    RSS differs by < 1 MB.  (Measured on this machine: ≈ 32 µs per step, ≈ 32 s.)"""
+def test_long_run_memory_flat(tmp_path):
+    """2·10⁵ steps (12 500 s, ten thousand kernel spans) through a load FMU with a convolution
+    memory: every 1000 steps the output is finite and the FMU's evaluator holds ≤ span/dt + 2
+    velocity nodes; at 10 %, 50 % and 100 % the load equals the exact integral over the window
+    and the process RSS differs by < 1 MB.  (10⁶ steps until 2026-12: the bound is reached after
+    22 steps, so the extra 8·10⁵ steps showed nothing more for 25 s of the suite's time.)"""
     (tmp_path / "flat.sim").write_text("\n".join(_group("SELF", "A", "A", FLAT_SAMPLES)) + "\n")
     folder = build(tmp_path, """
         [scene]
@@ -758,7 +759,7 @@ def test_million_steps_memory_flat(tmp_path):
         assert len(found) == 1          # the evaluator inside the FMU (its own runtime copy)
         ev = found[0]
         s, vr_v, vr_f = fmu.slave, [fmu.vr["velocity[1]"]], [fmu.vr["force[1]"]]
-        n, bound = 1_000_000, int(FLAT_SPAN / FLAT_DT) + 2
+        n, bound = 200_000, int(FLAT_SPAN / FLAT_DT) + 2
         checks, rss, start = {n // 10, n // 2, n}, [], time.perf_counter()
         for k in range(n + 1):
             t = k * FLAT_DT
@@ -774,7 +775,7 @@ def test_million_steps_memory_flat(tmp_path):
             if k < n:
                 s.doStep(t, FLAT_DT)
         elapsed = time.perf_counter() - start
-        print(f"10^6 FMU steps: {elapsed:.1f} s, RSS at 10/50/100 %: {rss} kB, nodes {ev.nodes} <= {bound}")
+        print(f"{n} FMU steps: {elapsed:.1f} s, RSS at 10/50/100 %: {rss} kB, nodes {ev.nodes} <= {bound}")
         assert max(rss) - min(rss) < 1024
         assert ev._v.shape[0] <= 4 * bound      # and its buffer does not grow either
     finally:

@@ -47,6 +47,23 @@ def _module_file(name):
     return path / "__init__.py" if (path / "__init__.py").is_file() else None
 
 
+_IMPORTS = {}   # file -> ((mtime_ns, size), its relative imports): a build parses each file once
+
+
+def _relative_imports(f):
+    """The relative ``from … import`` nodes of source file ``f`` (every one, module level or not),
+    parsed once per process while the file does not change (a batch or a test session builds
+    hundreds of scenes; the parse was most of a build check's time)."""
+    st = f.stat()
+    key = (st.st_mtime_ns, st.st_size)
+    known = _IMPORTS.get(f)
+    if known is None or known[0] != key:
+        nodes = [n for n in ast.walk(ast.parse(f.read_text(encoding="utf-8")))
+                 if isinstance(n, ast.ImportFrom) and n.level]
+        known = _IMPORTS[f] = (key, nodes)
+    return known[1]
+
+
 def runtime_files():
     """The runtime's source files, relative to the package (sorted)."""
     entry = PACKAGE / RUNTIME_ENTRY
@@ -60,9 +77,7 @@ def runtime_files():
         if rel == Path("__init__.py"):
             continue   # replaced by RUNTIME_INIT: the package's own imports (its public API) stay out
         here = list(rel.parent.parts)
-        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
-            if not (isinstance(node, ast.ImportFrom) and node.level):
-                continue
+        for node in _relative_imports(f):
             base = here[:len(here) - (node.level - 1)] if node.level > 1 else here
             mod = ".".join(base + ([node.module] if node.module else []))
             parts = mod.split(".") if mod else []
