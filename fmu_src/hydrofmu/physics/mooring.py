@@ -134,23 +134,36 @@ def moordyn_rates(angles, omega) -> np.ndarray:
 
 
 def _messages(text, level):
-    return tuple(line.strip() for line in text.splitlines() if line.startswith(level))
+    """MoorDyn's messages of ``level`` ('WRN', 'ERR'), each with the lines that continue it (up to
+    a blank or indented line, another message, or its summary of what it made)."""
+    out, current = [], None
+    for line in text.splitlines():
+        if line.startswith(level):
+            current = [line.strip()]
+            out.append(current)
+        elif current is not None and line.strip() and not line[0].isspace() \
+                and not line.startswith(("ERR", "WRN", "MSG", "DBG", "Generated entities")):
+            current.append(line.strip())
+        else:
+            current = None
+    return tuple(" ".join(m) for m in out)
 
 
 def _create(path):
-    """(MoorDyn instance, printed text); MooringError with MoorDyn's messages if it fails."""
+    """(MoorDyn instance, printed text, the file's folder left out: messages name the file
+    alone); MooringError with MoorDyn's messages if it fails."""
     import moordyn
     with captured() as out:
         try:
             md = moordyn.Create(str(path))
         except RuntimeError:
             md = None
+    text = out.text.replace(str(Path(path).parent) + os.sep, "")
     if md is None:
-        text = out.text.replace(str(Path(path).parent) + os.sep, "")   # messages name the file alone
         errors = [line for line in text.splitlines() if line.strip() and not line.startswith(" ")]
         start = next((i for i, line in enumerate(errors) if line.startswith("ERR")), None)
-        raise MooringError("\n".join(errors[start:] if start is not None else errors[-3:]), out.text)
-    return md, out.text
+        raise MooringError("\n".join(errors[start:] if start is not None else errors[-3:]), text)
+    return md, text
 
 
 def _objects(md):

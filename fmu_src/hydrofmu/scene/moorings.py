@@ -216,7 +216,7 @@ def _coupled(problems, name, deck, where, mapping, lengths, options, depth, bodi
         problems.add(f"{where}.moordyn", _moordyn_message(str(exc), deck, copy))
         return None
     for message in layout.warnings:
-        problems.warn(f"{where}.moordyn", f"{deck.path}: MoorDyn: {_strip(message)}")
+        problems.warn(f"{where}.moordyn", f"MoorDyn: {_users(_strip(message), deck, copy)}")
     for kind, ident in layout.unsupported:
         line = deck.bodies[ident].line if kind == "body" else deck.rods.get(ident)
         problems.add(f"{where}.moordyn", f"{deck.path.name}:{line}: {kind.capitalize()}{ident} is "
@@ -327,12 +327,15 @@ def _strip(message):
     return re.sub(r"^(ERR|WRN|MSG|DBG)\s+\S+:\d+\s+\S+\(\)\s*:\s*", "", message.strip())
 
 
-def _moordyn_message(text, deck, copy):
-    """MoorDyn's refusal, its lines mapped back to the user's file."""
+def _users(said, deck, copy):
+    """MoorDyn's text with the copy's 'name at line N' and 'name:N' as the user's file and line."""
     def user(found):
         line = copy.user_line(int(found.group(1)))
         return f"{deck.path}:{line}" if line else f"{deck.path} (an option hydrofmu set)"
-    lines = [_strip(t) for t in text.splitlines() if t.strip()]
-    said = " ".join(lines)
-    said = re.sub(rf"{re.escape(deck.path.name)} at line (\d+):?", lambda m: user(m) + ":", said)
-    return f"MoorDyn refused the file: {said}"
+    return re.sub(rf"{re.escape(deck.path.name)}(?: at line |:)(\d+)", user, said)
+
+
+def _moordyn_message(text, deck, copy):
+    """MoorDyn's refusal, its lines mapped back to the user's file."""
+    said = " ".join(_strip(t) for t in text.splitlines() if t.strip())
+    return f"MoorDyn refused the file: {_users(said, deck, copy)}"
