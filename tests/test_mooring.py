@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from moordyn_files import CHAIN, catenary, moordyn_file, wet_weight
+from moordyn_files import catenary, moordyn_file, wet_weight
 
 moordyn = pytest.importorskip("moordyn", reason="needs the moordyn package (pip install hydrofmu[mooring])")
 

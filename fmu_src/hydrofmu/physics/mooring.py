@@ -229,7 +229,11 @@ class Mooring:
         self.kinematics, self.phasors = kinematics, phasors
         path = self.workdir / filename
         path.write_text(text, encoding="utf-8")
-        self.md, self.log = _create(path)
+        try:
+            self.md, self.log = _create(path)
+        except MooringError:
+            shutil.rmtree(self.workdir, ignore_errors=True)
+            raise
         bodies, points, unsupported, self.line_ids, dof = _objects(self.md)
         by_key = {(c.kind, c.id): c for c in couplings}
         wanted = [("body", i) for i in bodies] + [("point", i) for i in points]
