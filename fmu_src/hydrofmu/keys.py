@@ -236,6 +236,16 @@ BEM_COUPLING = {
     **MEMORY,
 }
 
+MOORING = {
+    "moordyn": (STRING, "MoorDyn v2 input file, relative to the scene (line types, points, lines, options)"),
+    "bodies": ({"type": "object", "propertyNames": {"pattern": "^([Bb][Oo][Dd][Yy]|[Pp][Oo][Ii][Nn][Tt])[0-9]+$"},
+                "additionalProperties": STRING},
+               "the file's coupled objects -> scene bodies: Body<ID> (a coupled body) or Point<ID> (a coupled "
+               "point) = \"body\""),
+    "lengths": ({"type": "object", "propertyNames": {"pattern": "^[0-9]+$"}, "additionalProperties": POSITIVE},
+                "line ID -> unstretched length [m], replacing the file's UnstrLen (a batch knob)"),
+}
+
 BUILD = {
     "runtime": (enum("python", "c"), "the FMUs' flavour: pythonfmu (the reference) or compiled C (no Python at run time)"),
 }
@@ -251,6 +261,7 @@ SCENE = {
                   "SIMO hydrodynamic couplings ([[couplings]]: deck + coupling, or bem)"),
     "build": ({"table": BUILD}, "build settings (hydrofmu build)"),
     "waves": ({"table": WAVES}, "one wave field for the scene: the sea state ([waves])"),
+    "moorings": ({"map": MOORING}, "mooring lines from a MoorDyn file on the scene's bodies: [moorings.NAME]"),
 }
 
 CASES = {

@@ -11,11 +11,12 @@ from .bodies import read_body
 from .couplings import read_couplings
 from .current import read_current
 from .joints import read_joint
+from .moorings import read_moorings
 from .problems import Problems, identifier
 from .run import read_run, stable_defaults
 from .waves import check_wave_effects, feels_waves, read_wave_points, read_waves
 
-SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves")
+SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "build", "waves", "moorings")
 RUNTIMES = tuple(keys.BUILD["runtime"][0]["enum"])   # [build] runtime: fmi/build.py, fmi/cbuild.py
 
 
@@ -37,6 +38,7 @@ class Scene:
     runtime: str = "python"          # [build] runtime: "python" (pythonfmu) or "c" (compiled)
     waves: object = None             # physics.waves.SeaState of [waves], or None (no waves)
     wave_points: dict = field(default_factory=dict)   # [waves.points]: name -> {position} or {body, offset}
+    moorings: dict = field(default_factory=dict)   # [moorings.NAME]: name -> scene.moorings.MooringSpec
 
 
 def load_scene(path, overrides=None):
@@ -107,7 +109,11 @@ def _load_scene(path, overrides=None):
     points = read_wave_points(p, doc["waves"], bodies) if "waves" in doc else {}
     feels = bool(points) or bool(joints) or any(feels_waves(e) for b in bodies.values() for e in b.effects)
     check_wave_effects(p, bodies, sea, rho, g, feels)
-    _check_names(p, bodies, joints, couplings)
+    moorings = read_moorings(p, doc["moorings"], bodies, p.env, sea) if "moorings" in doc else {}
+    if moorings:
+        p.warn("moorings", "read and checked, not yet built: the FMUs of this version carry no mooring lines "
+                           "(the bodies keep only their own stiffness)")
+    _check_names(p, bodies, joints, couplings, moorings)
     if not p.items:   # defaults for what a valid scene holds (a scene with problems is refused below)
         stable_defaults(run_cfg, bodies, couplings, sea,
                         isinstance(doc.get("waves"), dict) and "ramp" not in doc["waves"], joints)
@@ -115,21 +121,22 @@ def _load_scene(path, overrides=None):
         name=name, path=path, joints=joints, couplings=couplings, rho=rho, g=g,
         current_speed=speed, current_direction=direction, current_profile=profile,
         bodies=bodies, run=run_cfg, decks=p.readings, runtime=runtime or "python", waves=sea,
-        wave_points=points if sea is not None else {},
+        wave_points=points if sea is not None else {}, moorings=moorings,
     )
     p.raise_if_any()
     return scene
 
 
-def _check_names(problems, bodies, joints, couplings):
-    """Names that become FMU files, instances and variables must never meet: bodies and
-    joints name FMU files (``<scene>_<name>.fmu``), compared ignoring case (a Windows or macOS
+def _check_names(problems, bodies, joints, couplings, moorings=()):
+    """Names that become FMU files, instances and variables must never meet: bodies, joints
+    and moorings name FMU files (``<scene>_<name>.fmu``), compared ignoring case (a Windows or macOS
     folder holds one of ``Barge.fmu`` and ``barge.fmu``); ``earth`` is a joint's side B, not
     a body; on one body, an effect's loads ``<name>.force`` must not meet a coupling's or a
     joint's of the same name (the load FMU and the results would hold two ``X.force``), nor
     ``total`` (the results' sum of every load)."""
     seen = {}
-    for key, name in [(f"bodies.{b}", b) for b in bodies] + [(f"joints.{j}", j) for j in joints]:
+    for key, name in ([(f"bodies.{b}", b) for b in bodies] + [(f"joints.{j}", j) for j in joints]
+                      + [(f"moorings.{m}", m) for m in moorings]):
         if name == "earth":
             problems.add(key, "'earth' is a joint's fixed side (b = \"earth\"), not a body name: rename the body")
         other = seen.setdefault(name.lower(), key)
