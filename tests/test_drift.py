@@ -169,6 +169,22 @@ def regular(a, w, beta=0.0, phase=0.0):
     return Components(np.array([w]), np.array([a]), np.array([beta]), np.array([phase]))
 
 
+def turned_by_hand(f, beta, between=(0.0, 45.0), weight=None):
+    """Surge, sway, yaw [F_x, F_y, M_z] at heading β from f(b) = [F_x, F_y, M_z] at the two
+    headings ``between``: (F_x, F_y) of each taken along and across its own heading, those
+    interpolated linearly in heading, then turned to β; yaw as it is (docs/waves.md, Headings)."""
+    b0, b1 = between
+    u = (beta - b0) / (b1 - b0) if weight is None else weight
+    framed = []
+    for b in between:
+        fx, fy, mz = f(b)
+        c, s = math.cos(math.radians(b)), math.sin(math.radians(b))
+        framed.append(np.array([c * fx + s * fy, -s * fx + c * fy, mz]))
+    lo, tr, mz = (1 - u) * framed[0] + u * framed[1]
+    c, s = math.cos(math.radians(beta)), math.sin(math.radians(beta))
+    return np.array([c * lo - s * tr, s * lo + c * tr, mz])
+
+
 def test_held_body_in_a_regular_wave_feels_a_squared_q(tmp_path):
     """The mean force of a regular wave = a²·Q(ω, ω)·ρgL^k, Q read from a .8 and interpolated
     in frequency and heading (the hand interpolation in the test), with the ramp squared."""
@@ -179,13 +195,13 @@ def test_held_body_in_a_regular_wave_feels_a_squared_q(tmp_path):
     a, per, beta = 1.3, 9.0, 30.0
     w = 2 * np.pi / per
     fw = (w - 2 * np.pi / 10) / (2 * np.pi / 8 - 2 * np.pi / 10)
+    q = turned_by_hand(lambda b: [(1 - fw) * f8(10.0, b, i) + fw * f8(8.0, b, i) for i in (1, 2, 6)], beta)
     for method in ("mean", "newman"):
         load = DriftLoad(method, regular(a, w, beta, 0.4), mean)
         for t in (25.0, 31.7):
             f = load(phasors(regular(a, w, beta, 0.4), t, ramp_length=20.0))
-            for i, k in ((1, 1), (2, 1), (6, 2)):
-                q = [(1 - fw) * f8(10.0, b, i) + fw * f8(8.0, b, i) for b in (0.0, 45.0)]
-                want = a ** 2 * (q[0] + (q[1] - q[0]) * beta / 45) * RHO * G * ULEN ** k
+            for c, (i, k) in enumerate(((1, 1), (2, 1), (6, 2))):
+                want = a ** 2 * q[c] * RHO * G * ULEN ** k
                 assert f[i - 1] == pytest.approx(want, rel=1e-9)
         half = load(phasors(regular(a, w, beta, 0.4), 10.0, ramp_length=20.0))
         assert half == pytest.approx(0.25 * f, rel=1e-12)                   # r = ½ at half the ramp: r²
@@ -440,10 +456,21 @@ def test_meandrift_regenerates_the_cylinder_drift(tmp_path):
     assert not (tmp_path / "no.nc").exists()
 
 
+def along_across(q, beta, back=False):
+    """q (6,) with (q1, q2) and (q4, q5) taken along and across heading β [deg] (``back``: the
+    other way)."""
+    c, s = math.cos(math.radians(beta)), math.sin(math.radians(beta)) * (-1 if back else 1)
+    out = np.array(q, complex)
+    for i, j in ((0, 1), (3, 4)):
+        out[i], out[j] = c * q[i] + s * q[j], -s * q[i] + c * q[j]
+    return out
+
+
 def test_bidirectional_qtf_in_a_spread_sea_is_bilinear_in_the_heading_pair():
     """A QTF with the heading pairs (0, 0), (0, 30), (30, 0), (30, 30) (the mixed ones each
     other's conjugate transpose): components at 10° and 25° feel Q interpolated bilinearly in
-    (β_i, β_j), computed by hand; the sum is real-symmetric (Hermitian data)."""
+    (β_i, β_j) in the frame of each pair's mean heading, computed by hand; the sum is
+    real-symmetric (Hermitian data)."""
     w = np.linspace(0.4, 1.4, 6)
     rng = np.random.default_rng(5)
     a00, a33 = hermitian_qtf(2 * np.pi / w, 1), hermitian_qtf(2 * np.pi / w, 2)
@@ -458,7 +485,7 @@ def test_bidirectional_qtf_in_a_spread_sea_is_bilinear_in_the_heading_pair():
     for i, (wi, bi) in enumerate(((1, 10.0), (3, 25.0))):
         for j, (wj, bj) in enumerate(((1, 10.0), (3, 25.0))):
             fa, fb = bi / 30.0, bj / 30.0
-            q = sum(corners[(a, b)][wi, wj] * (fa if a else 1 - fa) * (fb if b else 1 - fb)
-                    for a in (0, 1) for b in (0, 1))
-            want += (q * z[i] * np.conj(z[j])).real
+            q = sum(along_across(corners[(a, b)][wi, wj], 15.0 * (a + b)) * (fa if a else 1 - fa)
+                    * (fb if b else 1 - fb) for a in (0, 1) for b in (0, 1))
+            want += (along_across(q, (bi + bj) / 2, back=True) * z[i] * np.conj(z[j])).real
     assert np.allclose(DriftLoad("qtf", comps, data)(z), want, rtol=1e-12, atol=1e-12)
