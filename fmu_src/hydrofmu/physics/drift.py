@@ -197,14 +197,17 @@ def heading_error(mean: MeanDrift, comps: Components):
     is zero everywhere; dofs 1–2 and 4–5 scaled by their horizontal magnitude), F̄ = Σ_c a_c²·Q
     with the linear scheme of ``MeanDrift.at`` and the cubic of ``_cubic_weights``, both in the
     turning frame and linear in ω; n the number of components between two computed headings.
-    None when no component lies between headings, or the data have fewer than three."""
+    None when no component lies between headings; (None, n) when the data have fewer than
+    three headings (nothing to compare with)."""
     t = mean.table
     beta = np.mod(np.asarray(comps.direction, float), 360.0)
     gap = np.abs((beta[:, None] - t.directions[None, :] + 180.0) % 360.0 - 180.0)
     between = gap.min(axis=1) > DIRECTION_TOL
-    cubic = _cubic_weights(t.directions, t.closed, beta)
-    if not between.any() or cubic is None:
+    if not between.any():
         return None
+    cubic = _cubic_weights(t.directions, t.closed, beta)
+    if cubic is None:
+        return None, int(between.sum())
     w, a2 = np.asarray(comps.omega, float), np.asarray(comps.amplitude, float) ** 2
     v = t.values.real                                         # (nω, nβ, 6) in each heading's frame
     i0, i1, fw = _locate(t.omega, w, "mean drift")
