@@ -148,6 +148,50 @@ def test_bad_drift_set_ups_are_one_error(folder, case):
     assert key in str(err.value), str(err.value)
 
 
+def test_a_full_qtf_is_used_as_one_and_newman_is_weighed_against_it(folder):
+    """A .12d without a method is the full QTF; the build's notes hold Newman's slow-drift std
+    against the QTF's per dof for this sea (slow_drift_std's figures); method = "newman" by
+    choice is used, and where it departs beyond 10 % (heave here: the test QTF's diagonal
+    changes sign where its off-diagonal does not) it is a warning naming the dof; a
+    unidirectional QTF in a spread sea falls back to Newman by default, said."""
+    import warnings as w
+
+    from hydrofmu.assembly import assemble, notes
+    from hydrofmu.errors import InputWarning
+    from hydrofmu.physics.drift import slow_drift_std
+    sea = 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 40\nseed = 3\nramp = 0.0'
+    wv = 2 * np.pi / np.array(DRIFT_PERIODS)
+    q = hermitian_qtf(DRIFT_PERIODS)
+    q[np.arange(wv.size), np.arange(wv.size), 2] = np.sin(3 * wv) + 0.3        # heave's mean drift changes sign
+    write_12d(folder / "cyl.12d", DRIFT_PERIODS, q)
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea, f'bem = "cyl.12d"\nulen = {ULEN}'))
+    eff = sc.bodies["cyl"].effects[1]
+    assert eff.data["method"] == "qtf" and not [m for m in said if "Newman" in str(m.message)]
+    lines = [line for line in notes(sc, assemble(sc)) if "Newman / full QTF" in line]
+    assert len(lines) == 1 and "40 components" in lines[0], lines
+    comps = components(sc.waves, (wv.min(), wv.max()))
+    order = np.argsort(wv)
+    q = q * RHO * G * ULEN ** np.array([1, 1, 1, 2, 2, 2])
+    sq, sn = slow_drift_std(comps, QTF(wv[order], [(0.0, 0.0)], q[order][:, order][:, :, None, :]))
+    assert f"heave {sn[2] / sq[2]:.3f} ({sn[2]:.4g} / {sq[2]:.4g} N)" in lines[0]
+    assert abs(sn[2] / sq[2] - 1) > 0.1
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea, f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "newman"'))
+    assert sc.bodies["cyl"].effects[1].data["method"] == "newman"
+    off = [str(m.message) for m in said if "Newman's slow-drift std departs" in str(m.message)]
+    assert len(off) == 1 and "heave" in off[0] and "effects[1].method" in off[0], off
+    rows = (folder / "cyl.12d").read_text().splitlines(keepends=True)[1:]     # the pairs (0°, 0°) and (90°, 90°)
+    (folder / "uni.12d").write_text("".join(rows + [r[:28] + f"{90.0:14.6E}" * 2 + r[56:] for r in rows]))
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea + "\ndirection = 45.0\nspreading = 60.0", f'bem = "uni.12d"\nulen = {ULEN}'))
+    assert sc.bodies["cyl"].effects[1].data["method"] == "newman"
+    assert any("unidirectional heading pairs only" in str(m.message) for m in said)
+
+
 # -------------------------------------------------------------- compiled flavour (drift.c)
 
 PAIR = DATA / "wave_pair.nc"

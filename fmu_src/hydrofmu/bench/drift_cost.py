@@ -1,9 +1,14 @@
 """Cost and accuracy of the wave drift (``hydrofmu bench --part drift``).
 
+The full QTF at the peer's case (``semisub_cost``): the issue's semisubmersible (its QTF's
+grid, 200 components, cut-off 0.6 rad/s, HydroDyn's driver step 0.05 s), per step in both
+flavours: the first-order excitation, Newman, the full QTF's direct sum and its Chebyshev
+blocks (``DriftLoad.at``), and the peer's step as the issue's compiled ratios place it.
+
 Cost: seconds per step of each drift method (``physics.drift.DriftLoad`` with its phasors
 z_k(t), in-process, no FMI) beside the first-order kernel (``physics.waves.WaveLoad``) at
 50, 200 and 1000 components of a JONSWAP sea (Hs 2 m, Tp 9 s), interleaved rounds; ``qtf``
-with every pair and with a 0.3 rad/s cut-off.
+(its direct sum) with every pair and with a 0.3 rad/s cut-off.
 
 Accuracy: Newman's approximation against the full QTF on the test's QTF (tests/test_drift.py:
 Q(ω1, ω2) = 8e3·(1 + 0.4·(ω1 + ω2)) + 2e3i·(ω1 − ω2) N/m² in surge, a smooth wall-like
@@ -262,14 +267,32 @@ def newman_error(n=200, hours=2.0, dt=2.0, data=None):
             "surge_std_ratio": xn.std() / xq.std()}
 
 
-def lines(rows, err, crows=None):
+def lines(rows, err, crows=None, semi=None):
     """The part's summary lines; '(noisy)': the rounds of that count spread by more than 25 %."""
-    out = ["cost per step in-process (phasors included), × the first-order waves kernel: " + "; ".join(
+    out = []
+    if semi:
+        r = semi
+        out.append(f"the full QTF at the peer's case (semisubmersible grid, {r['components']} components, cut-off "
+                   f"{r['cutoff']:g} rad/s: {r['offsets']} offsets; step {r['dt']:g} s; blocks of {r['block_s']:.0f} s, "
+                   f"{r['block_terms']} terms), µs per step and × the first-order excitation of the same flavour: "
+                   f"compiled waves {r['c_waves_us']:.2f}, newman {r['c_newman_us']:.2f} "
+                   f"({r['c_newman_x_waves']:.2f}×), qtf direct {r['c_qtf_direct_us']:.1f} "
+                   f"({r['c_qtf_direct_x_waves']:.1f}×), qtf blocks {r['c_qtf_us']:.2f} ({r['c_qtf_x_waves']:.2f}×); "
+                   f"Python waves {r['py_waves_us']:.1f}, newman {r['py_newman_us']:.1f} ({r['py_newman_x_waves']:.2f}×), "
+                   f"qtf direct {r['py_qtf_direct_us']:.0f} ({r['py_qtf_direct_x_waves']:.1f}×), qtf blocks "
+                   f"{r['py_qtf_us']:.1f} ({r['py_qtf_x_waves']:.2f}×)" + (" (noisy)" if r["noisy"] else ""))
+        out.append(f"  the peer's step from the issue's ratios (qtf direct 2.2×, excitation + newman 0.47×, compiled) on "
+                   f"this run: {r['peer_us']:.1f} µs; with the blocks a compiled step is {r['c_blocks_x_peer']:.2f}× "
+                   f"the peer's (target ≤ 1), the Python kernels (waves + qtf blocks) {r['py_kernels_x_peer']:.2f}× "
+                   f"(target ≤ 3; pythonfmu's own step cost comes on top, the same for every method)")
+    out.append("cost per step in-process (phasors included; the full QTF by its direct sum), × the first-order "
+               "waves kernel: " + "; ".join(
         f"{r['components']} components: waves {r['waves_us']:.0f} µs, mean {r['mean_x_waves']:.2f}×, newman "
         f"{r['newman_x_waves']:.2f}×, qtf cut 0.3 rad/s ({r['qtf_cut_offsets']} offsets) {r['qtf_cut_x_waves']:.1f}×, "
-        f"qtf all pairs {r['qtf_x_waves']:.1f}×" + (" (noisy)" if r["noisy"] else "") for r in rows)]
+        f"qtf all pairs {r['qtf_x_waves']:.1f}×" + (" (noisy)" if r["noisy"] else "") for r in rows))
     if crows:
-        out.append("compiled kernels (physics/drift.c against waves.c's hf_waves, a C loop): " + "; ".join(
+        out.append("compiled kernels (physics/drift.c against waves.c's hf_waves, a C loop; the full QTF by its direct "
+                   "sum): " + "; ".join(
             f"{r['components']} components: waves {r['c_waves_us']:.2f} µs, mean {r['c_mean_x_waves']:.2f}×, newman "
             f"{r['c_newman_x_waves']:.2f}×, qtf cut 0.3 rad/s {r['c_qtf_cut_x_waves']:.1f}×, qtf all pairs "
             f"{r['c_qtf_x_waves']:.1f}×" + (" (noisy)" if r["c_noisy"] else "") for r in crows))

@@ -410,20 +410,10 @@ class DriftLoad:
             if keep.any():
                 band[i[keep], off] = qtf.at(w[i[keep]], w[j[keep]], beta[i[keep]], beta[j[keep]])
         band[:, 1:] *= 2.0                                    # the pair (j, i) is the conjugate: 2·Re
-        self.band, self.offsets = band, d
-        # the band as dense tiles for matrix products: rows [r0, r1), columns [r0, r1 + d), entry
-        # [j − r0, (i − r0)·6 + dof] = band[i, j − i, dof] (zero off the band): a few rows' sums in
-        # one product per tile, (1 + m/d) times the band's products
-        m = max(8, d // 4)
-        self._tiles = []
-        for r0 in range(0, n, m):
-            r1 = min(r0 + m, n)
-            c1 = min(r1 + d, n)
-            tile = np.zeros((c1 - r0, r1 - r0, 6), complex)
-            for i in range(r0, r1):
-                last = min(i + d, n - 1)
-                tile[i - r0:last - r0 + 1, i - r0] = band[i, :last - i + 1]
-            self._tiles.append((r0, r1, c1, tile.reshape(c1 - r0, -1)))
+        flat = band.reshape(-1, 6)
+        self.table = np.empty((2 * flat.shape[0], 6))          # rows [Re Q; −Im Q] interleaved like a complex
+        self.table[0::2], self.table[1::2] = flat.real, -flat.imag   # array's floats: Re(p·Q) in one product
+        self.offsets = d
 
     def __call__(self, z) -> np.ndarray:
         """(6,) [Fx, Fy, Fz, Mx, My, Mz] for the components' complex amplitudes z (N,): the
@@ -440,13 +430,15 @@ class DriftLoad:
 
     def _sums(self, z):
         """The QTF's direct sums Σ_i Σ_{d ≤ D} Re{band[i, d]·z_i·conj(z_{i+d})} (m, 6) for m rows
-        of sorted complex amplitudes z (m, N), tile by tile."""
-        out = np.zeros((z.shape[0], 6))
-        zc = np.conj(z)
-        for r0, r1, c1, tile in self._tiles:
-            y = (zc[:, r0:c1] @ tile).reshape(z.shape[0], r1 - r0, 6)
-            out += np.einsum("mi,mid->md", z[:, r0:r1], y).real
-        return out
+        of sorted complex amplitudes z (m, N)."""
+        m, n, d = z.shape[0], self.n, self.offsets
+        pad = np.zeros((m, n + d), complex)
+        pad[:, :n] = np.conj(z)
+        pairs = z[:, :, None] * np.lib.stride_tricks.sliding_window_view(pad, d + 1, axis=1)   # [., i, off]
+        # einsum, not a matrix product: BLAS's threads fight for the cores of a busy machine (a
+        # product of this shape was 10 to 50× slower on a loaded 2-core machine, as a batch's
+        # workers load it), einsum's loop does not
+        return np.einsum("mi,ij->mj", np.ascontiguousarray(pairs).reshape(m, -1).view(np.float64), self.table)
 
     def at(self, t, p) -> np.ndarray:
         """(6,) the un-ramped load at time t [s], ``p`` the components' phasors there (the
