@@ -53,7 +53,7 @@ static double angle_gap(double a, double b) {   /* |a - b| on the circle [deg] *
 
 #define BLOCK_X 40.0     /* drift.py's BLOCK_X and BLOCK_TOL */
 #define BLOCK_TOL 1e-15
-#define HEAD 13          /* params: [method, n, D, F_mean (6), L, K, t_last, block, coefficients...] */
+#define HEAD 13          /* params: [method, n, D, F_mean (6), L, K (0: no blocks), t_last, block, coefficients...] */
 
 /* drift.turn(back=True) of one value (6 complex as (re, im) pairs when stride 2, 6 reals when 1):
  * the horizontal pairs (1, 2) and (4, 5) from the frame of heading beta [deg] to global axes */
