@@ -271,7 +271,7 @@ double *hf_drift_build(const double *wave, const double *record, int nrecord, do
     }
     if (method < 2) {
         for (int k = 0; k < n; k++) {
-            double q[6], a2 = ampl[2 * k] * ampl[2 * k] + ampl[2 * k + 1] * ampl[2 * k + 1];
+            double q[6] = {0}, a2 = ampl[2 * k] * ampl[2 * k] + ampl[2 * k + 1] * ampl[2 * k + 1];
             if (mean_at(data, omega[k], beta[k], q, field, m, size)) goto bad;
             double b = beta[k] * PI / 180.0, ph = -hf_wave_number(omega[k], g, depth) * (x * cos(b) + y * sin(b));
             double c = cos(ph), s = sin(ph);
