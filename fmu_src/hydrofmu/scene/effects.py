@@ -201,8 +201,6 @@ def _wave_drift(problems, table, where):
     file); the sea state is the scene's [waves].  A QTF file read for mean or newman keeps the
     full QTF under ``full_qtf`` for the build's report (``drift_on_sea``), the kernel reading
     its diagonal."""
-    import math
-
     from ..decks.drift import QTF_SUFFIXES, read_mean_drift, read_qtf
     problems.known_keys(table, where, keys.effect_keys("wave_drift", False))
     is_qtf = str(table.get("bem", "")).endswith(QTF_SUFFIXES)
@@ -232,7 +230,11 @@ def _wave_drift(problems, table, where):
         full = {"pairs": [list(p) for p in data.pairs], "re": q.real.tolist(), "im": q.imag.tolist()}
         if method == "qtf":
             return {**out, **full}
-        mean = data.mean()
+        try:
+            mean = data.mean()
+        except InputError as exc:     # no unidirectional pair: no mean drift in the file
+            problems.add(f"{where}.bem", str(exc))
+            return None
         return {**out, "directions": mean.directions.tolist(), "values": mean.body(body).tolist(), "full_qtf": full}
     return {**out, "directions": data.directions.tolist(), "values": data.body(body).tolist()}
 
