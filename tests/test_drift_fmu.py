@@ -16,7 +16,7 @@ from hydrofmu.physics.drift import QTF, DriftLoad, phasors  # noqa: E402
 from hydrofmu.physics.waves import components  # noqa: E402
 from hydrofmu.scene import load_scene  # noqa: E402
 
-from test_drift import f8, hermitian_qtf, mean_rows, write_12d  # noqa: E402
+from test_drift import f8, hermitian_qtf, mean_rows, turned_by_hand, write_12d  # noqa: E402
 
 DATA = Path(__file__).parent / "data" / "bem"
 ONE = DATA / "wave_cylinder.nc"
@@ -92,14 +92,15 @@ REGULAR = 'spectrum = "regular"\nheight = 3.0\nperiod = 9.0\ndirection = 30.0\nr
 @pytest.mark.parametrize("method", ["mean", "newman"])
 def test_held_body_in_a_regular_wave_feels_a2_q(folder, method):
     """drift.force = a²·Q(ω, ω; β)·ρgL^k after the ramp (Q interpolated by hand between the
-    .8's 10 s and 8 s rows and its 0° and 45° headings), r(t)² during it."""
+    .8's 10 s and 8 s rows and its 0° and 45° headings, in the frame turning with the heading),
+    r(t)² during it."""
     t, d, _ = held(scene(folder, REGULAR, f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "{method}"'), 20.0)
     w = 2 * math.pi / 9.0
     fw = (w - 2 * math.pi / 10) / (2 * math.pi / 8 - 2 * math.pi / 10)
     after = t >= 10.0
-    for i, k in ((1, 1), (2, 1), (6, 2)):
-        q = [(1 - fw) * f8(10.0, b, i) + fw * f8(8.0, b, i) for b in (0.0, 45.0)]
-        want = 1.5 ** 2 * (q[0] + (q[1] - q[0]) * 30.0 / 45.0) * RHO * G * ULEN ** k
+    q = turned_by_hand(lambda b: [(1 - fw) * f8(10.0, b, i) + fw * f8(8.0, b, i) for i in (1, 2, 6)], 30.0)
+    for c, (i, k) in enumerate(((1, 1), (2, 1), (6, 2))):
+        want = 1.5 ** 2 * q[c] * RHO * G * ULEN ** k
         np.testing.assert_allclose(d[after, i - 1], want, rtol=1e-9)
         r = 0.5 * (1 - np.cos(np.pi * t[~after] / 10.0))
         np.testing.assert_allclose(d[~after, i - 1], r ** 2 * want, rtol=1e-9, atol=1e-12 * abs(want))
@@ -145,6 +146,50 @@ def test_bad_drift_set_ups_are_one_error(folder, case):
     with pytest.raises(InputError) as err:
         load_scene(path)
     assert key in str(err.value), str(err.value)
+
+
+def test_a_full_qtf_is_used_as_one_and_newman_is_weighed_against_it(folder):
+    """A .12d without a method is the full QTF; the build's notes hold Newman's slow-drift std
+    against the QTF's per dof for this sea (slow_drift_std's figures); method = "newman" by
+    choice is used, and where it departs beyond 10 % (heave here: the test QTF's diagonal
+    changes sign where its off-diagonal does not) it is a warning naming the dof; a
+    unidirectional QTF in a spread sea falls back to Newman by default, said."""
+    import warnings as w
+
+    from hydrofmu.assembly import assemble, notes
+    from hydrofmu.errors import InputWarning
+    from hydrofmu.physics.drift import slow_drift_std
+    sea = 'spectrum = "jonswap"\nhs = 2.0\ntp = 8.0\ncomponents = 40\nseed = 3\nramp = 0.0'
+    wv = 2 * np.pi / np.array(DRIFT_PERIODS)
+    q = hermitian_qtf(DRIFT_PERIODS)
+    q[np.arange(wv.size), np.arange(wv.size), 2] = np.sin(3 * wv) + 0.3        # heave's mean drift changes sign
+    write_12d(folder / "cyl.12d", DRIFT_PERIODS, q)
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea, f'bem = "cyl.12d"\nulen = {ULEN}'))
+    eff = sc.bodies["cyl"].effects[1]
+    assert eff.data["method"] == "qtf" and not [m for m in said if "Newman" in str(m.message)]
+    lines = [line for line in notes(sc, assemble(sc)) if "Newman / full QTF" in line]
+    assert len(lines) == 1 and "40 components" in lines[0], lines
+    comps = components(sc.waves, (wv.min(), wv.max()))
+    order = np.argsort(wv)
+    q = q * RHO * G * ULEN ** np.array([1, 1, 1, 2, 2, 2])
+    sq, sn = slow_drift_std(comps, QTF(wv[order], [(0.0, 0.0)], q[order][:, order][:, :, None, :]))
+    assert f"heave {sn[2] / sq[2]:.3f} ({sn[2]:.4g} / {sq[2]:.4g} N)" in lines[0]
+    assert abs(sn[2] / sq[2] - 1) > 0.1
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea, f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "newman"'))
+    assert sc.bodies["cyl"].effects[1].data["method"] == "newman"
+    off = [str(m.message) for m in said if "Newman's slow-drift std departs" in str(m.message)]
+    assert len(off) == 1 and "heave" in off[0] and "effects[1].method" in off[0], off
+    rows = (folder / "cyl.12d").read_text().splitlines(keepends=True)[1:]     # the pairs (0°, 0°) and (90°, 90°)
+    (folder / "uni.12d").write_text("".join(rows + [r[:28] + f"{90.0:14.6E}" * 2 + r[56:] for r in rows]))
+    with w.catch_warnings(record=True) as said:
+        w.simplefilter("always", InputWarning)
+        sc = load_scene(scene(folder, sea + "\ndirection = 45.0\nspreading = 60.0", f'bem = "uni.12d"\nulen = {ULEN}'))
+    assert sc.bodies["cyl"].effects[1].data["method"] == "newman"
+    assert any("unidirectional heading pairs only" in str(m.message) for m in said)
 
 
 # -------------------------------------------------------------- compiled flavour (drift.c)
@@ -208,26 +253,31 @@ type = "wave_drift"
 
 SPREAD = ('spectrum = "jonswap"\nhs = 3.0\ntp = 9.0\ndirection = 200.0\nspreading = 6.0\ncomponents = 60\nseed = 5\n'
           'ramp = 15.0')
-COMPILED_CASES = {
+COMPILED_CASES = {   # (waves, drift, parameters at initialization, steps of 0.1 s)
     "mean, regular": ('spectrum = "regular"\nheight = 2.0\nperiod = 7.0\ndirection = 30.0\nramp = 10.0',
-                      f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "mean"', {"waves.period": 8.5}),
-    "newman, spread": (SPREAD, f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "newman"', {"waves.seed": 11.0}),
+                      f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "mean"', {"waves.period": 8.5}, 300),
+    "newman, spread": (SPREAD, f'bem = "cyl.8"\nulen = {ULEN}\nmethod = "newman"', {"waves.seed": 11.0}, 300),
+    # the full QTF by its blocks (physics.drift.DriftLoad.at): 80 s at the 1 rad/s cut-off, 42 s for
+    # the spread sea's bandwidth; the records cross a block's end
     "qtf, long-crested, cut-off": (SPREAD.replace("spreading = 6.0", "spreading = 0.0").replace("200.0", "0.0"),
-                                   f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "qtf"\ncutoff = 0.4', {"waves.hs": 2.0}),
-    "qtf, bidirectional, spread": (SPREAD, f'bem = "bi.12d"\nulen = {ULEN}\nmethod = "qtf"', {"waves.seed": 9.0}),
+                                   f'bem = "cyl.12d"\nulen = {ULEN}\nmethod = "qtf"\ncutoff = 1.0', {"waves.hs": 2.0},
+                                   900),
+    "qtf, bidirectional, spread": (SPREAD, f'bem = "bi.12d"\nulen = {ULEN}\nmethod = "qtf"', {"waves.seed": 9.0},
+                                   600),
 }
 
 
 @pytest.mark.parametrize("case", list(COMPILED_CASES))
 def test_drift_compiled_equals_python(folder, case, tmp_path):
     """physics/drift.c on the components waves.c draws = physics/drift.py on Python's, every
-    output of the load FMU to 1e-10 of its range over 300 steps, a body 10 m from the origin,
-    the sea state changed through waves.* at initialization."""
+    output of the load FMU to 1e-10 of its range over 300 steps (the full QTF: 600–900, across
+    the end of a block), a body 10 m from the origin, the sea state changed through waves.* at
+    initialization."""
     from hydrofmu.fmi.build import build_scene
     from test_compiled import assert_equal_flavours
     (folder / "cyl.8").write_text("".join(mean_rows(DRIFT_PERIODS, [0.0, 90.0, 180.0, 270.0], [1, 2, 6], f8)))
     write_bidirectional_12d(folder / "bi.12d", DRIFT_PERIODS, [0.0, 90.0, 180.0, 270.0])
-    waves, drift, params = COMPILED_CASES[case]
+    waves, drift, params, steps = COMPILED_CASES[case]
     built = build_scene(load_scene(pair_scene(folder, waves, drift)), folder / "fmus", log=lambda *_: None,
                         runtime="c")
-    assert assert_equal_flavours(built, tmp_path, steps=300, params=params, loads_only=True) <= 1e-10
+    assert assert_equal_flavours(built, tmp_path, steps=steps, params=params, loads_only=True) <= 1e-10

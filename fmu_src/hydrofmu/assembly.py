@@ -323,9 +323,10 @@ def fit_memories(couplings):
 def notes(scene, system):
     """Build-time lines for the user: what was read from each deck (the groups used and
     skipped, by name and line: decks.lines.Reading), every cross coupling's stability
-    indicator (with a warning where explicit coupling diverges) and every state-space fit's
-    order and error."""
+    indicator (with a warning where explicit coupling diverges), every state-space fit's
+    order and error, and each wave drift's report (scene.effects.drift_on_sea)."""
     out = [line for reading in scene.decks for line in reading.summary()]
+    out += [line for b in scene.bodies.values() for e in b.effects for line in e.data.get("report", ())]
     for name, rho in system.indicators.items():
         c = next(c for c in scene.couplings if c.name == name)
         explicit = "explicit" in (scene.bodies[c.a].accel_mode, scene.bodies[c.b].accel_mode)

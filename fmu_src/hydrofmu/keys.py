@@ -146,8 +146,10 @@ EFFECTS["wave_drift"] = {"deck": {}, "inline": {
     **BEM_EFFECT,
     "bem": (STRING, "drift: WAMIT .7/.8/.9 (mean), .10d/.11d/.12d (QTF) or a Capytaine dataset with the "
                     "far-field drift (hydrofmu meandrift)"),
-    "method": (enum("mean", "newman", "qtf"), "mean drift, Newman's approximation (default) or the full "
-                                              "difference-frequency QTF (WAMIT .10d/.11d/.12d)"),
+    "method": (enum("mean", "newman", "qtf"), "mean drift, Newman's approximation or the full difference-frequency "
+                                              "QTF; default qtf for a QTF file (WAMIT .10d/.11d/.12d; newman when "
+                                              "it is unidirectional and the sea spread), newman for mean drift "
+                                              "files"),
     "cutoff": (POSITIVE, "qtf: the largest |ω_i − ω_j| kept [rad/s] (default: every pair)"),
     "period_variable": PERIOD_VARIABLE,
 }}

@@ -6,7 +6,7 @@
 
 #include "../physics/kernels.h"
 
-double hf_bench_per_call(const double *wave, const double *drift, int steps, double dt) {
+double hf_bench_per_call(const double *wave, double *drift, int steps, double dt) {
     struct timespec a, b;
     double out[7], sink = 0.0;
     HfPhasors *P = hf_wave_phasors(wave);
@@ -15,7 +15,7 @@ double hf_bench_per_call(const double *wave, const double *drift, int steps, dou
     for (int k = 0; k < steps; k++) {
         double t = k * dt;
         if (!drift) hf_waves(wave, P, t, out);
-        else hf_drift(drift, hf_phasors_at(P, t), hf_phasors_ramp(P), out);
+        else hf_drift(drift, hf_phasors_at(P, t), t, hf_phasors_ramp(P), out);
         sink += out[0];
     }
     clock_gettime(CLOCK_MONOTONIC, &b);

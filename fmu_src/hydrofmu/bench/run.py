@@ -22,9 +22,10 @@ Parts (each also callable alone, see ``PARTS``):
   instance pool (``robust``)
 - batch: load-case batches on Dask, speed-up from 1 to 2 local workers and the dispatch
   overhead per case (``batch_cost``)
-- drift: the wave drift's cost per step per method (mean, newman, qtf with and without a
-  cut-off) against the first-order kernel at 50, 200, 1000 components, and Newman's error
-  against the full QTF (``drift_cost``)
+- drift: the full QTF at the peer's case (the semisubmersible, Chebyshev blocks against the
+  direct sum, both flavours); the wave drift's cost per step per method (mean, newman, qtf
+  with and without a cut-off) against the first-order kernel at 50, 200, 1000 components,
+  and Newman's error against the full QTF (``drift_cost``)
 - waves: the `waves` effect's cost per step against the pythonfmu floor for 50, 200 and
   1000 components, and per 100 components (``waves_cost``); the floating cylinder's and the
   pair's motions in regular waves next to their lightly damped resonances, long runs at
@@ -598,9 +599,11 @@ def part_drift(out, quick):
     rows = drift_cost.cost(counts, rounds=2 if quick else 5)
     crows = drift_cost.c_cost(counts, rounds=2 if quick else 5)
     err = drift_cost.newman_error(hours=0.5 if quick else 2.0)
+    semi = drift_cost.semisub_cost(rounds=2 if quick else 5)
     write_csv(out / "drift.csv", [{**r, **c} for r, c in zip(rows, crows)])
     write_csv(out / "drift_newman.csv", [err])
-    return drift_cost.lines(rows, err, crows)
+    write_csv(out / "drift_semisub.csv", [semi])
+    return drift_cost.lines(rows, err, crows, semi)
 
 
 PARTS = {"overhead": part_overhead, "memory": part_memory, "sweep": part_sweep, "growth": part_growth,

@@ -18,17 +18,21 @@ to the incident elevation at the origin, A the complex amplitude a·e^{iφ}):
   lines ``PER BETA1 BETA2 I Mod Pha Re Im``, F̄ = F/(ρ·g·A²·L^k), k = 1 forces, 2 moments
   (L = ``ulen``).  ``.8`` has I = 1, 2, 6 only (heave, roll, pitch read as zero by its
   definition; a ``.8`` row with I = 3, 4, 5 or a second body is refused).  Rows with
-  BETA1 = BETA2 are the mean drift of a unidirectional wave (real: an imaginary part above
-  1e-6 of the modulus is refused); rows with BETA1 ≠ BETA2 (bidirectional, WAMIT's
-  Re{A₁A₂*·F̄}) are kept in ``cross`` and not used by the mean drift of a sea (the
-  cross terms of two random-phase components average to zero).
+  BETA1 = BETA2 are the mean drift of a unidirectional wave, real: an imaginary part above
+  REAL_RTOL of the file's largest |F̄| is refused at its line (WAMIT leaves round-off there,
+  ~1e-7 of the largest value, on dofs that are zero by symmetry: the entry's own size is no
+  scale for it), the real part kept.  Rows with BETA1 ≠ BETA2 (bidirectional, WAMIT's
+  Re{A₁A₂*·F̄}) are kept in ``cross``, not used by the mean drift of a sea (the cross terms
+  of two random-phase components average to zero) and said in ``warnings``.
 - ``.10d`` / ``.11d`` / ``.12d``: lines ``PER1 PER2 BETA1 BETA2 I Mod Pha Re Im``, the same
   non-dimensionalisation, WAMIT's own difference-frequency form
   F = Re Σ_i Σ_j A_i·A_j*·F̄⁻_ij·e^{i(ω_i − ω_j)t} = ours, no conversion.  One triangle is
-  enough (the other is its complex conjugate with the headings swapped); a pair written in
-  both triangles must agree (1e-6 of the larger modulus, 1e-12 absolute); a pair of the
+  enough (the other is its complex conjugate with the headings swapped); an entry written in
+  both triangles must agree with its mirror's conjugate to MIRROR_RTOL of the file's largest
+  |F̄| (the two are then averaged), an error naming both lines otherwise; a pair of the
   frequency grid written in neither is an error.  The diagonal (PER1 = PER2, BETA1 = BETA2)
-  is the mean drift.
+  is its own mirror, the mean drift: real to REAL_RTOL of the file's largest |F̄| (as for
+  ``.7/.8/.9``), the real part kept.
 
 Both (``lines.numeric_rows``, the first-order readers' rules): lines before the first row that
 do not start like a number are header lines (WAMIT's NUMHDR = 1: "WAMIT Numeric Output --
@@ -62,8 +66,10 @@ from .lines import numeric_rows
 
 MEAN_SUFFIXES = (".7", ".8", ".9")
 QTF_SUFFIXES = (".10d", ".11d", ".12d")
-CONJ_RTOL = 1e-6      # a pair written in both triangles: conj agreement, relative to the larger modulus
-REAL_RTOL = 1e-6      # a unidirectional mean drift's imaginary part, relative to its modulus
+# the checks are scaled by the file's largest |value| (non-dimensional for WAMIT), never by the
+# entry's own: a dof zero by symmetry holds round-off as large as its own value
+REAL_RTOL = 1e-4      # a mean drift's (diagonal's) imaginary part (WAMIT's round-off: ~1e-7)
+MIRROR_RTOL = 1e-3    # an entry written in both triangles against its mirror's conjugate
 HEADING_TOL = 1e-6    # deg
 
 
@@ -227,6 +233,21 @@ def _dof_warning(path, given, kind):
     return [f"{path}: dof(s) {absent} not in the file: read as zero (WAMIT leaves out what it does not compute)"]
 
 
+def _largest(table):
+    """The file's largest |Re + i·Im| (non-dimensional, finite periods): its checks' scale."""
+    big = max((abs(v) for vals in table.values() for v in vals.values()), default=0.0)
+    return big if big > 0 else 1.0
+
+
+def _not_real(path, number, key, i, value, scale):
+    """An error when a mean drift (a diagonal entry) is not real to REAL_RTOL of ``scale``."""
+    if abs(value.imag) > REAL_RTOL * scale:
+        raise InputError(path, number, "IM", f"{_key_text(key)}, I = {i}: the mean drift (a diagonal entry is its "
+                                             f"own mirror) is real, found Im = {value.imag:g} against Re = "
+                                             f"{value.real:g}, above {REAL_RTOL:g} of the file's largest |value| "
+                                             f"{scale:g} (WAMIT's round-off stays near 1e-7 of it)")
+
+
 def _wamit_mean(path, ulen, rho, g, variable="period"):
     _scale_checked(path, ulen, rho, g)
     rows = _rows(path, ["PER", "BETA1", "BETA2", "I", "MOD", "PHA", "RE", "IM"])
@@ -245,10 +266,12 @@ def _wamit_mean(path, ulen, rho, g, variable="period"):
             raise InputError(path, number, "PER BETA1 BETA2 I", f"duplicate ({per:g}, {b1:g}, {b2:g}, {i}) (first at "
                                                                 f"line {first[key]})")
         first[key] = number
-        if b1 == b2 and abs(im) > REAL_RTOL * max(abs(complex(re, im)), 1e-300) and abs(im) > 1e-12:
-            raise InputError(path, number, "IM", f"the mean drift of a unidirectional wave (BETA1 = BETA2) is real, "
-                                                 f"found Im = {im:g} against Re = {re:g}")
         table.setdefault((per, b1, b2), {})[i] = complex(re, im)
+    scale = _largest(table)
+    for key, vals in table.items():
+        for i, v in vals.items():
+            if key[1] == key[2]:
+                _not_real(path, first[key + (i,)], key, i, v, scale)
     keys = sorted(table)
     given = _missing_dofs(path, table, keys, first)
     periods = sorted({k[0] for k in keys}, key=omega_of.get)      # increasing ω
@@ -278,9 +301,15 @@ def _wamit_mean(path, ulen, rho, g, variable="period"):
                                                             f"PER = {p:g} (given at other periods)")
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
+    warnings = _dof_warning(path, given, path.suffix)
+    if cross:
+        lines = sorted(first[k] for k in first if k[1] != k[2])
+        warnings.append(f"{path}: {len(lines)} bidirectional rows (BETA1 ≠ BETA2, heading pairs "
+                        f"{', '.join(f'({a:g}°, {b:g}°)' for a, b in sorted(cross))}; lines {lines[0]}…{lines[-1]}) "
+                        f"are not read: the mean drift of a sea uses the unidirectional rows (BETA1 = BETA2)")
     return MeanDriftData(str(path), f"WAMIT {path.suffix}", np.array([omega_of[p] for p in periods]),
                          np.array(uni, float),
-                         values, dofs, bodies, cross=cross, warnings=_dof_warning(path, given, path.suffix))
+                         values, dofs, bodies, cross=cross, warnings=warnings)
 
 
 def _wamit_qtf(path, ulen, rho, g, variable="period"):
@@ -299,8 +328,8 @@ def _wamit_qtf(path, ulen, rho, g, variable="period"):
             raise InputError(path, number, "PER1 PER2 BETA1 BETA2 I", f"duplicate ({p1:g}, {p2:g}, {b1:g}, {b2:g}, "
                                                                       f"{i}) (first at line {first[key]})")
         first[key] = number
-        table.setdefault((p1, p2, b1, b2), {})[i] = _dim(complex(re, im), i, rho, g, ulen)
-    keys = sorted(table)
+        table.setdefault((p1, p2, b1, b2), {})[i] = complex(re, im)     # non-dimensional until checked
+    keys, scale = sorted(table), _largest(table)
     given = _missing_dofs(path, table, keys, first)
     periods = sorted({k[0] for k in keys} | {k[1] for k in keys}, key=omega_of.get)    # increasing ω
     if len(periods) < 2:
@@ -310,38 +339,37 @@ def _wamit_qtf(path, ulen, rho, g, variable="period"):
     pos = {p: k for k, p in enumerate(periods)}
     ppos = {p: k for k, p in enumerate(pairs)}
     q = np.full((n, n, npair, nd), np.nan, complex)
-    line = np.zeros((n, n, npair), int)
-    for (p1, p2, b1, b2), vals in table.items():
+    line = np.zeros((n, n, npair, nd), int)       # the row each entry came from (0: none yet)
+    for key, vals in table.items():
+        p1, p2, b1, b2 = key
         i, j, h, hc = pos[p1], pos[p2], ppos[(b1, b2)], ppos[(b2, b1)]
-        v = np.array([vals[d] for d in given])
-        number = max(first[(p1, p2, b1, b2, d)] for d in given)
-        for (a, b, c, val) in ((i, j, h, v), (j, i, hc, np.conj(v))):
-            if line[a, b, c]:
-                old = q[a, b, c]
-                scale = np.maximum(np.abs(old), np.abs(val))
-                if np.any(np.abs(old - val) > CONJ_RTOL * scale + 1e-12 * max(rho * g * ulen ** 2, 1.0)):
-                    raise InputError(path, number, "RE IM", f"{_key_text((p1, p2, b1, b2))} is written in both "
-                                                            f"triangles but is not the complex conjugate of its mirror "
-                                                            f"(line {line[a, b, c]})")
-            q[a, b, c], line[a, b, c] = val, number
-    holes = np.argwhere(line == 0)
+        for c, d in sorted(enumerate(given), key=lambda cd: first[key + (cd[1],)]):   # in the file's order
+            v, number = vals[d], first[key + (d,)]
+            if (i, h) == (j, hc):          # the diagonal: its own mirror, the mean drift
+                _not_real(path, number, key, d, v, scale)
+                q[i, i, h, c], line[i, i, h, c] = v.real, number
+                continue
+            for (a, b, e, val) in ((i, j, h, v), (j, i, hc, np.conj(v))):
+                if line[a, b, e, c]:       # written in the other triangle too
+                    old = q[a, b, e, c]
+                    if abs(old - val) > MIRROR_RTOL * scale:
+                        m = old if (a, b, e) == (i, j, h) else np.conj(old)    # the mirror's conjugate
+                        raise InputError(path, number, "RE IM",
+                                         f"{_key_text(key)}, I = {d}: written in both triangles, but not the complex "
+                                         f"conjugate of its mirror (line {line[a, b, e, c]}): {v.real:g}{v.imag:+g}i "
+                                         f"against the mirror's conjugate {m.real:g}{m.imag:+g}i, apart by "
+                                         f"{abs(old - val):.3g}, above {MIRROR_RTOL:g} of the file's largest |value| "
+                                         f"{scale:g}")
+                    val = 0.5 * (old + val)
+                q[a, b, e, c], line[a, b, e, c] = val, number
+    holes = np.argwhere(line[..., 0] == 0)
     if holes.size:
         a, b, c = holes[0]
         raise InputError(path, None, "PER1 PER2 BETA1 BETA2",
                          f"{len(holes)} (PER1, PER2, headings) combination(s) written in neither triangle, first "
                          f"PER1 = {periods[a]:g}, PER2 = {periods[b]:g}, headings {pairs[c]} (the file's periods "
                          f"make a {n} × {n} grid; every pair must be in one triangle)")
-    idx = np.arange(n)
-    for c, (b1, b2) in enumerate(pairs):
-        if b1 == b2:
-            d = q[idx, idx, c]
-            bad = np.abs(d.imag) > REAL_RTOL * np.abs(d) + 1e-12
-            if bad.any():
-                k, m = np.argwhere(bad)[0]
-                raise InputError(path, line[k, k, c], "IM", f"the diagonal (PER1 = PER2 = {periods[k]:g}, "
-                                                            f"BETA1 = BETA2 = {b1:g}°) is the mean drift, real; "
-                                                            f"found Im = {d[k, m].imag:g}")
-            q[idx, idx, c] = d.real
+    q *= np.array([_dim(1.0, d, rho, g, ulen) for d in given])
     dofs = [(f"body{(d - 1) // 6 + 1}", (d - 1) % 6 + 1) for d in given]
     bodies = list(dict.fromkeys(b for b, _ in dofs))
     return QTFData(str(path), f"WAMIT {path.suffix}", np.array([omega_of[p] for p in periods]), pairs, q, dofs, bodies,
@@ -397,13 +425,17 @@ def _capytaine_mean(path):
             raise InputError(path, None, name, f"{bad.sum()} non-finite value(s) on the diagonal, first at omega="
                                                f"{omega[keep][order][solved][i]:g} rad/s, wave_direction="
                                                f"{np.degrees(rad[j]):g}°")
-        if np.any(np.abs(diag.imag) > REAL_RTOL * np.abs(diag) + 1e-9 * max(np.abs(diag).max(), 1.0)):
-            raise InputError(path, None, name, "the diagonal (wave_direction_k = wave_direction_l) is the mean drift, "
-                                               "real; found imaginary parts")
-        values.append(diag.real)
+        values.append(diag)
         if rad.size > 1 and not any("bidirectional" in w for w in warnings):
             warnings.append(f"{path}: {name}: the bidirectional entries (wave_direction_k ≠ wave_direction_l) are not "
                             f"read (the mean drift of a sea uses the diagonal)")
+    scale = max(float(np.abs(np.stack(values)).max()), 1e-300)     # the dataset's largest |value|
+    for name, diag in zip(names, values):
+        if np.any(np.abs(diag.imag) > REAL_RTOL * scale):
+            raise InputError(path, None, name, f"the diagonal (wave_direction_k = wave_direction_l) is the mean drift, "
+                                               f"real; found Im up to {np.abs(diag.imag).max():g}, above {REAL_RTOL:g} "
+                                               f"of the dataset's largest |value| {scale:g}")
+    values = [diag.real for diag in values]
     omega = omega[keep][order][solved]
     if omega.size < 1:
         raise InputError(path, None, "omega", "no finite frequency: no mean drift")

@@ -446,9 +446,10 @@ static void load_evaluate(Instance *inst) {
         memcpy(v + L->wave_force, w, sizeof(double) * 6);
         v[L->wave_elevation] = w[6];
     }
-    if (L->sea.waves && inst->running && L->sea.drift)   /* on the phasors advanced above */
-        hf_drift(L->sea.drift, hf_phasors_at(L->sea.phasors, inst->has_next ? inst->next_time : 0.0),
-                 hf_phasors_ramp(L->sea.phasors), v + L->drift_force);
+    if (L->sea.waves && inst->running && L->sea.drift) {   /* on the phasors advanced above */
+        double t = inst->has_next ? inst->next_time : 0.0;
+        hf_drift(L->sea.drift, hf_phasors_at(L->sea.phasors, t), t, hf_phasors_ramp(L->sea.phasors), v + L->drift_force);
+    }
     if (L->sea.waves && inst->running && L->sea.npoints) sea_points(inst, &L->sea, m);
     double *total = v + L->total;
     for (int i = 0; i < 6; i++) total[i] = 0.0;

@@ -678,7 +678,7 @@ class LoadSlave(ArraySlave):
             v[self.elevation] = w[6]
         if self.drift is not None:   # the last row: quadratic in the ramped phasors r·p
             r = self.phasors.ramp_factor
-            out[-1] = self.drift(p) * (r * r)
+            out[-1] = self.drift.at(self.next_time or 0.0, p) * (r * r)
         if self.points and self.kin is not None:
             m = self.motion(self.motion_inputs) if any(b for _, b, _ in self.points) else None
             where = [m.position + m.rot @ x if on_body else x for x, on_body, _ in self.points]

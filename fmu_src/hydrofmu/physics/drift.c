@@ -11,6 +11,12 @@
  *   mean:   F = r^2 sum_k |p_k|^2 Q_kk = r^2 F_mean (a_k fixed: F_mean once)
  *   newman: F = r^2 (|sum_k p_k s+_k|^2 - |sum_k p_k s-_k|^2), s = sqrt(Q+-) e^{-i k_k d_k}
  *   qtf:    F = r^2 sum_i sum_{d=0..D} Re{w_d Q(i, i + d) p_i conj(p_{i+d})}, w_0 = 1, w_d = 2
+ *   qtf by blocks (hf_drift with t, drift.py's DriftLoad.at): on the block [bL, (b + 1)L) of
+ *           absolute time the direct sum at its K Chebyshev nodes, once, then per step the
+ *           Chebyshev series at tau (Clenshaw), when K h <= L/2 (h the last step length)
+ * Values are interpolated in heading in the frame turning with the wave (drift.py, Headings):
+ * the record holds them in each heading's (each pair's mean heading's) frame and the
+ * interpolated value is turned back to the component's direction.
  * Record (Drift.c_params): [method, cutoff (-1: none), x, y, nw, w (nw), data]; data:
  * mean/newman [nb, closed, directions (nb), values (nw nb 6)]; qtf [nh, closed, bidirectional,
  * nu, closed (unidirectional), uni (nu), headings (nh), x, y, re (nw nw nh nh 6), im (same)].
@@ -43,6 +49,37 @@ static int locate(const double *w, int nw, double x, int *i0, int *i1, double *f
 static double angle_gap(double a, double b) {   /* |a - b| on the circle [deg] */
     double d = fmod(fmod(a - b + 180.0, 360.0) + 360.0, 360.0) - 180.0;
     return fabs(d);
+}
+
+#define BLOCK_X 40.0     /* drift.py's BLOCK_X and BLOCK_TOL */
+#define BLOCK_TOL 1e-15
+#define HEAD 13          /* params: [method, n, D, F_mean (6), L, K (0: no blocks), t_last, block, coefficients...] */
+
+/* drift.turn(back=True) of one value (6 complex as (re, im) pairs when stride 2, 6 reals when 1):
+ * the horizontal pairs (1, 2) and (4, 5) from the frame of heading beta [deg] to global axes */
+static void turn_back(double *v, double beta, int stride) {
+    double b = beta * PI / 180.0, c = cos(b), s = sin(b);
+    for (int i = 0; i < 4; i += 3)
+        for (int part = 0; part < stride; part++) {
+            double x = v[stride * i + part], y = v[stride * (i + 1) + part];
+            v[stride * i + part] = c * x - s * y, v[stride * (i + 1) + part] = c * y + s * x;
+        }
+}
+
+static double mean_heading(double a, double b) {   /* drift.mean_heading */
+    double d = fmod(fmod(b - a + 180.0, 360.0) + 360.0, 360.0) - 180.0;
+    return a + 0.5 * d;
+}
+
+/* drift.block_plan: K of the blocks of length L = 2 BLOCK_X / mu_max (0: no block) */
+static int block_terms(void) {
+    double x = BLOCK_X, term = 1.0;
+    int n = 0;
+    while (!(n + 1 > x / 2 && 4 * term / (1 - x / (2 * (n + 1))) <= BLOCK_TOL)) {
+        n++;
+        term *= x / (2 * n);
+    }
+    return n;
 }
 
 static int say(char *field, const char *name, char *m, size_t size, const char *text, ...) {
@@ -147,6 +184,7 @@ static int qtf_at(const Qtf *Q, double wi, double wj, double bi, double bj, doub
                 size_t at = ((((size_t)wi_[a] * Q->nw + wj_[b]) * Q->nh + ha[c]) * Q->nh + hb[c]) * 6;
                 for (int k = 0; k < 12; k++) q[k] += wgt * Q->local[2 * at + k];
             }
+    turn_back(q, mean_heading(bi, bj), 2);
     return 0;
 }
 
@@ -166,6 +204,7 @@ static int mean_at(const double *p, double w, double beta, double *out, char *fi
         out[q] = (1 - fw) * ((1 - fb) * V(i0, j0) + fb * V(i0, j1)) + fw * ((1 - fb) * V(i1, j0) + fb * V(i1, j1));
 #undef V
     }
+    turn_back(out, beta, 1);
     return 0;
 }
 
@@ -182,8 +221,10 @@ int hf_drift_record_ok(const double *r, int n) {   /* the record's sizes agree w
     return nh >= 1 && nu >= 0 && nu <= nh && n == 5 + nw + 5 + nu + nh + 2 + 12 * nw * nw * nh * nh;
 }
 
-/* params: [method, n, D, F_mean (6), coefficients]: mean none, newman s+ and s- (n 6 complex each),
- * qtf the band (n (D + 1) 6 complex, the pair (j, i) folded in: 2 Q off the diagonal) */
+/* params: [method, n, D, F_mean (6), L, K, t_last, block, coefficients]: mean none, newman s+ and
+ * s- (n 6 complex each), qtf the band (n (D + 1) 6 complex, the pair (j, i) folded in: 2 Q off the
+ * diagonal) then the blocks' data: A_k = a_k e^{i phi_k} (n complex), w (n), the nodes on [0, L]
+ * (K), the DCT (K K), the block's coefficients (K 6), node values (K 6), phasors (n complex) */
 double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
                        char *m, size_t size) {
     (void)nrecord;
@@ -210,13 +251,27 @@ double *hf_drift_build(const double *wave, const double *record, int nrecord, do
         }
     }
     size_t ncoef = method == 0 ? 0 : method == 1 ? 24 * (size_t)n : 12 * (size_t)n * (D + 1);
-    double *p = calloc(9 + ncoef, sizeof(double));
+    double mu_max = n > 1 ? omega[n - 1] - omega[0] : 0.0;
+    if (cutoff >= 0 && cutoff < mu_max) mu_max = cutoff;
+    int K = method == 2 && mu_max > 0 ? block_terms() : 0;
+    size_t nblock = K ? 5 * (size_t)n + (size_t)K * (K + 13) : 0;
+    double *p = calloc(HEAD + ncoef + nblock, sizeof(double));
     if (!p) goto oom;
     p[0] = method, p[1] = n, p[2] = D;
-    double *mean = p + 3, *coef = p + 9;
+    p[9] = K ? 2 * BLOCK_X / mu_max : 0.0, p[10] = K, p[11] = NAN, p[12] = NAN;
+    double *mean = p + 3, *coef = p + HEAD;
+    if (K) {
+        double *A = coef + ncoef, *w = A + 2 * n, *nodes = w + n, *dct = nodes + K;
+        for (int k = 0; k < n; k++) A[2 * k] = ampl[2 * k], A[2 * k + 1] = ampl[2 * k + 1], w[k] = omega[k];
+        for (int k = 0; k < K; k++) {
+            double theta = (2 * k + 1) * PI / (2 * K);
+            nodes[k] = 0.5 * p[9] * (1 + cos(theta));
+            for (int m = 0; m < K; m++) dct[m * K + k] = (m ? 2.0 : 1.0) / K * cos(m * theta);
+        }
+    }
     if (method < 2) {
         for (int k = 0; k < n; k++) {
-            double q[6], a2 = ampl[2 * k] * ampl[2 * k] + ampl[2 * k + 1] * ampl[2 * k + 1];
+            double q[6] = {0}, a2 = ampl[2 * k] * ampl[2 * k] + ampl[2 * k + 1] * ampl[2 * k + 1];
             if (mean_at(data, omega[k], beta[k], q, field, m, size)) goto bad;
             double b = beta[k] * PI / 180.0, ph = -hf_wave_number(omega[k], g, depth) * (x * cos(b) + y * sin(b));
             double c = cos(ph), s = sin(ph);
@@ -259,9 +314,47 @@ bad:
     return NULL;
 }
 
-void hf_drift(const double *params, const double *z, double r, double *out) {
-    int method = (int)params[0], n = (int)params[1], D = (int)params[2];
-    const double *coef = params + 9;
+/* the QTF's direct sum on the phasors z (n complex) into out (6) */
+static void qtf_sum(const double *params, const double *z, double *out) {
+    int n = (int)params[1], D = (int)params[2];
+    memset(out, 0, sizeof(double) * 6);
+    for (int i = 0; i < n; i++) {
+        double zr = z[2 * i], zi = z[2 * i + 1];
+        int last = i + D < n ? i + D : n - 1;
+        const double *q = params + HEAD + 12 * (size_t)i * (D + 1);
+        for (int j = i; j <= last; j++, q += 12) {   /* p_i conj(p_j) */
+            double xr = zr * z[2 * j] + zi * z[2 * j + 1], xi = zi * z[2 * j] - zr * z[2 * j + 1];
+            for (int k = 0; k < 6; k++) out[k] += xr * q[2 * k] - xi * q[2 * k + 1];
+        }
+    }
+}
+
+/* the Chebyshev coefficients of block b (the direct sum at its K nodes) */
+static void qtf_block(double *params, double b) {
+    int n = (int)params[1], D = (int)params[2], K = (int)params[10];
+    double L = params[9];
+    double *A = params + HEAD + 12 * (size_t)n * (D + 1), *w = A + 2 * n, *nodes = w + n, *dct = nodes + K;
+    double *c = dct + (size_t)K * K, *vals = c + 6 * K, *z = vals + 6 * K;
+    for (int k = 0; k < K; k++) {
+        double t = b * L + nodes[k];
+        for (int m = 0; m < n; m++) {
+            double cs = cos(w[m] * t), sn = sin(w[m] * t);
+            z[2 * m] = A[2 * m] * cs - A[2 * m + 1] * sn, z[2 * m + 1] = A[2 * m] * sn + A[2 * m + 1] * cs;
+        }
+        qtf_sum(params, z, vals + 6 * k);
+    }
+    for (int m = 0; m < K; m++)
+        for (int j = 0; j < 6; j++) {
+            double sum = 0.0;
+            for (int k = 0; k < K; k++) sum += dct[m * K + k] * vals[6 * k + j];
+            c[6 * m + j] = sum;
+        }
+    params[12] = b;
+}
+
+void hf_drift(double *params, const double *z, double t, double r, double *out) {
+    int method = (int)params[0], n = (int)params[1];
+    const double *coef = params + HEAD;
     double r2 = r * r;
     if (method == 0) {   /* |p_k| = a_k: the mean is fixed, ramped */
         for (int j = 0; j < 6; j++) out[j] = r2 * params[3 + j];
@@ -281,14 +374,25 @@ void hf_drift(const double *params, const double *z, double r, double *out) {
         for (int j = 0; j < 6; j++) out[j] = r2 * (pr[j] * pr[j] + pi[j] * pi[j] - mr[j] * mr[j] - mi[j] * mi[j]);
         return;
     }
-    for (int i = 0; i < n; i++) {
-        double zr = z[2 * i], zi = z[2 * i + 1];
-        int last = i + D < n ? i + D : n - 1;
-        const double *q = coef + 12 * (size_t)i * (D + 1);
-        for (int j = i; j <= last; j++, q += 12) {   /* p_i conj(p_j) */
-            double xr = zr * z[2 * j] + zi * z[2 * j + 1], xi = zi * z[2 * j] - zr * z[2 * j + 1];
-            for (int k = 0; k < 6; k++) out[k] += xr * q[2 * k] - xi * q[2 * k + 1];
-        }
+    int K = (int)params[10];
+    double L = params[9], step = isnan(params[11]) ? INFINITY : fabs(t - params[11]);
+    params[11] = t;
+    double b = K ? floor(t / L) : 0.0;
+    if (!K || (params[12] != b && !(step > 0 && K * step <= 0.5 * L))) {   /* the direct sum */
+        qtf_sum(params, z, out);
+        for (int k = 0; k < 6; k++) out[k] *= r2;
+        return;
     }
-    for (int k = 0; k < 6; k++) out[k] *= r2;
+    if (params[12] != b) qtf_block(params, b);
+    const double *c = params + HEAD + 12 * (size_t)n * ((int)params[2] + 1) + 3 * (size_t)n + (size_t)K * (K + 1);
+    double tau = 2 * (t - b * L) / L - 1;
+    tau = tau < -1 ? -1 : tau > 1 ? 1 : tau;
+    for (int j = 0; j < 6; j++) {   /* Clenshaw: sum_m c_m T_m(tau) */
+        double b1 = 0.0, b2 = 0.0;
+        for (int m = K - 1; m >= 1; m--) {
+            double b0 = 2 * tau * b1 - b2 + c[6 * m + j];
+            b2 = b1, b1 = b0;
+        }
+        out[j] = r2 * (c[j] + tau * b1 - b2);
+    }
 }

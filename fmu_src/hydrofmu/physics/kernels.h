@@ -115,11 +115,12 @@ void hf_waves(const double *params, HfPhasors *P, double t, double *out);
 int hf_direction_weights(const double *d, int nb, int closed, double beta, int *j0, int *j1, double *frac);
 
 /* drift.c: the wave drift of a body on the components of hf_wave_build's parameters
- * (physics.drift.DriftLoad), the record from Drift.c_params; per step from the shared phasors
- * p (n (re, im) pairs, un-ramped) and the ramp r: out (6) */
+ * (physics.drift.DriftLoad), the record from Drift.c_params; per step at time t from the shared
+ * phasors p there (n (re, im) pairs, un-ramped) and the ramp r: out (6); the full QTF's blocks
+ * are kept in params (a pure function of t, physics.drift.DriftLoad.at) */
 double *hf_drift_build(const double *wave, const double *record, int nrecord, double g, double depth, char *field,
                        char *message, size_t size);
-void hf_drift(const double *params, const double *p, double r, double *out);
+void hf_drift(double *params, const double *p, double t, double r, double *out);
 int hf_drift_record_ok(const double *record, int n);
 
 /* wave_kinematics.c: Airy kinematics of the components at a point.  params [n, g, depth,

@@ -1,5 +1,8 @@
 """The effect tables of a body (``[[bodies.NAME.effects]]``): each validator turns its table
 into kernel data, from inline values or a vendor deck (RIFLEX BODY/CONB lumped data too)."""
+import math
+from pathlib import Path
+
 import numpy as np
 
 from .. import admissible, keys
@@ -194,35 +197,119 @@ def _bem_hydrostatics(problems, table, where):
 def _wave_drift(problems, table, where):
     """Second-order wave drift from a BEM result (WAMIT .7/.8/.9/.10d/.11d/.12d, Capytaine
     dataset with the far-field drift): mean drift or the difference-frequency QTF of one BEM
-    body, ``method`` mean | newman | qtf; the sea state is the scene's [waves]."""
-    import math
-
+    body, ``method`` mean | newman | qtf (default qtf for a QTF file, newman for a mean drift
+    file); the sea state is the scene's [waves].  A QTF file read for mean or newman keeps the
+    full QTF under ``full_qtf`` for the build's report (``drift_on_sea``), the kernel reading
+    its diagonal."""
     from ..decks.drift import QTF_SUFFIXES, read_mean_drift, read_qtf
     problems.known_keys(table, where, keys.effect_keys("wave_drift", False))
-    method = problems.choice(table, "method", f"{where}.method", ("mean", "newman", "qtf"), "newman")
+    is_qtf = str(table.get("bem", "")).endswith(QTF_SUFFIXES)
+    method = problems.choice(table, "method", f"{where}.method", ("mean", "newman", "qtf"),
+                             "qtf" if is_qtf else "newman")
     cutoff = problems.number(table, "cutoff", f"{where}.cutoff", positive=True) if "cutoff" in table else math.inf
     if method is None or cutoff is None:
         return None
     if "cutoff" in table and method != "qtf":
         problems.add(f"{where}.cutoff", f"applies to method = \"qtf\" only (this effect's method is {method!r})")
         return None
-    qtf = method == "qtf"
-    if qtf and not str(table.get("bem", "")).endswith(QTF_SUFFIXES):
+    if method == "qtf" and not is_qtf:
         problems.add(f"{where}.bem", "method = \"qtf\" needs a difference-frequency QTF: a WAMIT .10d, .11d or .12d "
                                      "file (mean drift files hold the diagonal only: use method = \"newman\")")
         return None
-    data, path, body = _bem_entry(problems, table, where, read_qtf if qtf else read_mean_drift)
+    data, path, body = _bem_entry(problems, table, where, read_qtf if is_qtf else read_mean_drift)
     if data is None:
         return None
     for message in data.warnings:
         problems.warn(f"{where}.bem", message)
     out = {"bem": str(path), "body": body, "kind": data.kind, "method": method, "cutoff": cutoff,
-           "omega": data.omega.tolist(), "rotation_center": data.rotation_centers.get(body), "rho": data.rho,
-           "g": data.g, "water_depth": data.water_depth}
-    if qtf:
+           "method_default": "method" not in table, "omega": data.omega.tolist(),
+           "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g,
+           "water_depth": data.water_depth}
+    if is_qtf:
         q = data.body(body)
-        return {**out, "pairs": [list(p) for p in data.pairs], "re": q.real.tolist(), "im": q.imag.tolist()}
+        full = {"pairs": [list(p) for p in data.pairs], "re": q.real.tolist(), "im": q.imag.tolist()}
+        if method == "qtf":
+            return {**out, **full}
+        try:
+            mean = data.mean()
+        except InputError as exc:     # no unidirectional pair: no mean drift in the file
+            problems.add(f"{where}.bem", str(exc))
+            return None
+        return {**out, "directions": mean.directions.tolist(), "values": mean.body(body).tolist(), "full_qtf": full}
     return {**out, "directions": data.directions.tolist(), "values": data.body(body).tolist()}
+
+
+DOF = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+NEWMAN_TOL = 0.10     # Newman's slow-drift std against the full QTF's: said beyond it
+HEADING_TOL = 0.02    # the heading interpolation's error estimate: said beyond it
+
+
+def drift_on_sea(problems, where, eff, body, comps, sea, g):
+    """A ``wave_drift`` effect on the sea's components (scene.waves.check_wave_effects): the
+    default method of a unidirectional QTF in a spread sea becomes newman (said); the kernel is
+    built (a physics.waves.WaveError when the data do not hold the sea); the report lines in
+    ``eff.data["report"]`` (printed by the build): Newman's slow-drift std against the full
+    QTF's per dof where the file is a QTF (a warning beyond NEWMAN_TOL when the run uses
+    Newman) and the heading interpolation's error estimate (a warning beyond HEADING_TOL)."""
+    from ..description import Drift
+    from ..physics.drift import QTF, heading_error, slow_drift_std
+    d = eff.data
+    full = d.get("full_qtf") or ({k: d[k] for k in ("pairs", "re", "im")} if "pairs" in d else None)
+    qtf = None if full is None else QTF(d["omega"], [tuple(p) for p in full["pairs"]],
+                                        np.array(full["re"]) + 1j * np.array(full["im"]))
+    spread = sea.spreading > 0
+    if d["method"] == "qtf" and d.get("method_default") and spread and not qtf.bidirectional:
+        mean = qtf.diagonal()
+        d.update(method="newman", directions=mean.directions.tolist(), values=mean.values.tolist(), full_qtf=full)
+        for k in ("pairs", "re", "im"):
+            d.pop(k)
+        problems.warn(f"{where}.method", f"{Path(d['bem']).name} holds unidirectional heading pairs only and the sea "
+                                         f"is spread (waves.spreading): Newman's approximation is used (set method "
+                                         f"= \"newman\" to say so, or give bidirectional pairs for the full QTF)")
+    drift = Drift.of(eff, body.position)
+    data = drift.data(g, sea.depth)
+    drift.kernel(comps, g, sea.depth)
+    name, report = Path(d["bem"]).name, []
+    if qtf is not None and (qtf.bidirectional or not spread):
+        sq, sn = slow_drift_std(comps, qtf, drift.cutoff)
+        kind_max = [max(sq[:3].max(), sn[:3].max()), max(sq[3:].max(), sn[3:].max())]
+        shown = [k for k in range(6) if max(sq[k], sn[k]) > 1e-3 * kind_max[k // 3]]
+        ratio = {k: sn[k] / sq[k] if sq[k] > 0 else math.inf for k in shown}
+        band = f", |ω_i − ω_j| ≤ {drift.cutoff:g} rad/s" if math.isfinite(drift.cutoff) else ""
+        report.append(f"drift of {body.name} ({name}, method {d['method']}): slow-drift std for this sea "
+                      f"({comps.omega.size} components{band}), Newman / full QTF: "
+                      + ", ".join(f"{DOF[k]} {ratio[k]:.3f} ({sn[k]:.4g} / {sq[k]:.4g} {'N' if k < 3 else 'N·m'})"
+                                  for k in shown))
+        off = [k for k in shown if abs(ratio[k] - 1) > NEWMAN_TOL]
+        if off and d["method"] == "newman":
+            problems.warn(f"{where}.method", f"Newman's slow-drift std departs from the full QTF's by more than "
+                                             f"{100 * NEWMAN_TOL:g} % for this sea: "
+                                             + ", ".join(f"{DOF[k]} {ratio[k]:.2f}×" for k in off)
+                                             + f" ({name} is a full QTF: method = \"qtf\", its default, uses it)")
+    mean = data.diagonal() if isinstance(data, QTF) else data
+    est = heading_error(mean, comps)
+    if est is not None:
+        err, n = est
+        heads = ", ".join(f"{h:g}°" for h in mean.table.directions)
+        if err is None:
+            problems.warn(f"{where}.bem", f"{n} of the sea's {comps.omega.size} components lie between the only two "
+                                          f"headings of {name} ({heads}): the heading interpolation's error cannot be "
+                                          f"estimated (it is exact for a body the same from every heading); add "
+                                          f"headings around the sea's direction (waves.direction = "
+                                          f"{sea.direction:g}°) to the BEM run")
+        else:
+            report.append(f"drift of {body.name} ({name}): heading interpolation at {n} of {comps.omega.size} "
+                          f"components between headings {heads}, linear against cubic on the mean drift: "
+                          + ", ".join(f"{DOF[k]} {100 * err[k]:.2g} %" for k in range(6) if err[k] > 0))
+            bad = [k for k in range(6) if err[k] > HEADING_TOL]
+            if bad:
+                problems.warn(f"{where}.bem", f"the heading interpolation of {name}'s drift may be off by "
+                                              + ", ".join(f"{100 * err[k]:.2g} % in {DOF[k]}" for k in bad)
+                                              + f" for this sea (linear against cubic between its headings "
+                                              f"{heads}): add headings around the sea's direction (waves.direction "
+                                              f"= {sea.direction:g}°) to the BEM run, or turn the sea onto a "
+                                              f"computed heading")
+    d["report"] = report
 
 
 # type -> (validator, default effect name)

@@ -7,9 +7,9 @@ import numpy as np
 
 from .. import keys
 from ..admissible import WAVE_KEYS_USED, depth_mismatch, ignored_wave_keys, sea_problems, size_problem
-from ..description import Drift
 from ..errors import numbers
 from .couplings import CENTRE_TOL
+from .effects import drift_on_sea
 
 WAVE_KEYS = keys.names(keys.WAVES)
 # the ramp a sea state gets unless [waves] sets one: this many peak periods (a start without
@@ -213,8 +213,8 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
             problems.add(f"waves.{exc.field}", f"{name} ({where}): {exc}")
             return
     for where, name, body, eff in drifts:
-        try:   # the drift of these components: data within the window, QTF headings for the sea
-            Drift.of(eff, body.position).kernel(comps, g or 9.81, sea.depth)
+        try:   # the drift of these components: data within the window, QTF headings for the sea; its report
+            drift_on_sea(problems, where, eff, body, comps, sea, g or 9.81)
         except WaveError as exc:
             key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
             problems.add(key, f"{name} ({where}): {exc}")
