@@ -2,6 +2,7 @@
 here (fixed and on-body points), a RIFLEX body's load in the FMU against the kernel at the same
 time, the scene's errors (file and key path), the compiled build's refusal."""
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -237,3 +238,45 @@ def test_fmu_state_with_kinematics_continues_exactly(tmp_path):
         assert np.array_equal(run(pstep, lambda: py.get_real(outs), 30, 30), plater), fmu.name
         span = np.ptp(plater, axis=0)
         assert np.all(np.abs(plater - later) <= 1e-10 * np.where(span > 0, span, 1.0) + 1e-300)
+
+
+@pytest.mark.parametrize("extra, key, said", [
+    ('depth = 50.0\n[waves.points.bad]\nposition = [0.0, 0.0, -60.0]', "waves.points.bad.position",
+     r"z = -60 m is below the sea bed \(waves.depth = 50 m\)"),
+    ('[waves.points.bad]\nposition = [0.0, 0.0, 50.0]', "waves.points.bad.position",
+     r"z = 50 m is above the highest crest of the scene's sea \(1 m: the sum of the components' amplitudes"),
+    ('[waves.points.bad]\nbody = "barge"\noffset = [0.0, 0.0, 1.5]', "waves.points.bad.offset",
+     r"z = 1.5 m at the initial pose of body 'barge' is above the highest crest"),
+    ('depth = 50.0\n[waves.points.bad]\nbody = "barge"\noffset = [0.0, 0.0, -51.0]', "waves.points.bad.offset",
+     r"z = -51 m at the initial pose of body 'barge' is below the sea bed"),
+])
+def test_point_never_in_the_water_is_a_warning_naming_it(tmp_path, extra, key, said):
+    """A named point below the bed or above every crest the scene's sea reaches (Σ a_k: a
+    regular wave's H/2 = 1 m here) never gets wet: its outputs stay 0, said once naming it;
+    points at the bed itself and under the crest (z = 0.9 m) are left alone."""
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE.format(extra=extra))
+    with pytest.warns(Warning) as caught:
+        scene = load_scene(path)
+    said_here = [str(w.message) for w in caught if key in str(w.message)]
+    assert len(said_here) == 1 and re.search(said, said_here[0]) and "never in the water" in said_here[0]
+    assert sum(key in w for w in scene.warnings) == 1
+    quiet = extra.replace("-60.0", "-50.0").replace("50.0]", "0.9]").replace("1.5]", "0.9]").replace("-51.0]", "-50.0]")
+    path.write_text(SCENE.format(extra=quiet))
+    assert not [w for w in load_scene(path).warnings if "never in the water" in w]
+
+
+def test_spectrum_point_far_above_the_crests_is_a_warning():
+    """A spectrum of many components: Σ a_k (here 3.4·Hs) would let a point at 3.2·Hs pass;
+    3·Hs, which a Rayleigh crest passes with probability e^{−72} per wave, is the limit then."""
+    import warnings
+    from hydrofmu.scene.problems import Problems
+    from hydrofmu.scene.waves import read_wave_points
+    sea = waves.SeaState("jonswap", hs=2.0, tp=8.0, components=200, seed=1)
+    assert np.sum(waves.components(sea).amplitude) > 3.3 * 2.0
+    for z, warned in ((6.4, True), (5.9, False)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            read_wave_points(Problems("s.toml"), {"points": {"p": {"position": [0.0, 0.0, z]}}}, {}, sea)
+        said = [str(w.message) for w in caught]
+        assert bool(said) == warned and (not said or "3·Hs" in said[0] and "waves.points.p.position" in said[0])
