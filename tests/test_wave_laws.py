@@ -269,12 +269,13 @@ def test_kernel_orbit_sense_in_irregular_seas(spectrum):
     assert np.corrcoef(rows[:, 1, 2], detadt)[0, 1] > 0.6
 
 
-def scene_text(spectrum, depth, stretching, pts, surface=None):
+def scene_text(spectrum, depth, stretching, pts, surface=None, effects=""):
     """A held body and the named points ``pts`` (global) in SEAS[spectrum]; ``surface``:
-    (x, y) of a point on the body (its position input moves it), for Wheeler's surface."""
+    (x, y) of a point on the body (its position input moves it), for Wheeler's surface;
+    ``effects``: the body's effect tables (TOML)."""
     lines = ["[scene]", 'name = "laws"', "[run]", f"step = {H}", "stop = 1.0",
              "[bodies.b]", "position = [0.0, 0.0, 0.0]", "mass = 1.0e6", "inertia = [1e8, 1e8, 1e8]",
-             "stiffness = [1e5, 1e5, 1e7, 1e9, 1e9, 1e8]",
+             "stiffness = [1e5, 1e5, 1e7, 1e9, 1e9, 1e8]", effects,
              "[waves]", SEAS[spectrum], "ramp = 0.0", f'stretching = "{stretching}"']
     if not math.isinf(depth):
         lines.append(f"depth = {depth}")
@@ -307,17 +308,22 @@ class Flavour:
             s.exitInitializationMode()
             self.set, self.get, self.step = s.setReal, s.getReal, s.doStep
 
-    def record(self, names, steps, heave=None):
-        """{name: (1, steps, 8)} of the points' outputs after each step of H; ``heave``:
-        the body's position[3] set before each step (a sequence of ``steps``)."""
-        refs = [self.vr[f"waves.{n}.{c}"] for n in names for c in OUTPUTS]
-        out = np.empty((steps, len(names), 8))
+    def outputs(self, names, steps, heave=None):
+        """(steps, len(names)) of the outputs ``names`` after each step of H; ``heave``: the
+        body's position[3] set before each step (a sequence of ``steps``)."""
+        refs = [self.vr[n] for n in names]
+        out = np.empty((steps, len(names)))
         for i in range(steps):
             if heave is not None:
                 self.set([self.vr["position[3]"]], [float(heave[i])])
             self.step(i * H, H)
-            out[i] = np.reshape(self.get(refs), (len(names), 8))
-        return {n: out[None, :, j, :] for j, n in enumerate(names)}
+            out[i] = self.get(refs)
+        return out
+
+    def record(self, names, steps, heave=None):
+        """{point name: (1, steps, 8)} of the named points' outputs (``outputs``)."""
+        out = self.outputs([f"waves.{n}.{c}" for n in names for c in OUTPUTS], steps, heave)
+        return {n: out[None, :, 8 * j:8 * j + 8] for j, n in enumerate(names)}
 
 
 def built(tmp, text):

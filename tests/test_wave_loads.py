@@ -259,3 +259,73 @@ def test_joined_barges_clump_with_and_without_waves(tmp_path):
     assert np.ptp(calm[50:]) < 0.05 * np.ptp(surge[50:])   # the calm load barely moves; the waves' does
     png = kinematics_cost.plot_clump(res, tmp_path / "clump.png")
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def box_surface(centre, half, n=8):
+    """Gauss–Legendre nodes (P, 3), outward normals (P, 3) and weights (P,) [m²] on the six
+    faces of a box of half-sides ``half`` about ``centre``."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    pts, normals, weights = [], [], []
+    for axis in range(3):
+        a, b = [i for i in range(3) if i != axis]
+        u, v = np.meshgrid(x, x, indexing="ij")
+        ww = np.outer(w, w).ravel() * half[a] * half[b]
+        for side in (-1.0, 1.0):
+            p = np.zeros((u.size, 3))
+            p[:, axis] = side * half[axis]
+            p[:, a], p[:, b] = u.ravel() * half[a], v.ravel() * half[b]
+            nrm = np.zeros_like(p)
+            nrm[:, axis] = side
+            pts.append(p + centre), normals.append(nrm), weights.append(ww)
+    return np.vstack(pts), np.vstack(normals), np.concatenate(weights)
+
+
+@pytest.mark.parametrize("spectrum, depth", [("regular", math.inf), ("spread", 30.0), ("jonswap", 8.0)])
+def test_froude_krylov_on_a_small_body_is_rho_v_a(spectrum, depth, tmp_path):
+    """Gauss: the incident pressure on a small submerged body, −∮p·n dS with the total
+    pressure p = p_d − ρg·z of the kinematics integrated here over a box (half-sides 0.5, 0.3,
+    0.4 m, 8×8 Gauss points a face), equals ρ·V·(a + g·e_z) in every direction: the RIFLEX
+    BODY's ρ·AE·a_w + ρ·g·AE (AE = V), kernel and load FMU (both flavours), and ρ·V times a
+    named point's acceleration.  The box's mean acceleration differs from the centre's by
+    Σ r_i²/6·∂²a/∂x_i² (harmonic a: zero for a cube) and higher orders: for each component at
+    most (k·r_max)²/6·(1 + (k·r_max)²) of its acceleration amplitude ω²·a·F_h, the tolerance.
+    (Stretching none: the body stays below the troughs, Airy as it stands.)"""
+    from test_wave_laws import SEAS, Flavour, Sea, built, scene_text, sea_state
+    centre, half = np.array([4.0, -3.0, -5.0 if depth > 10 else -4.5]), np.array([0.5, 0.3, 0.4])
+    where = tuple(float(c) for c in centre)
+    vol = float(8 * half.prod())
+    comps = waves.components(sea_state(spectrum, depth, "none"))
+    kin, ph = WaveKinematics(comps, G, depth), Phasors(comps)
+    pts, normals, weights = box_surface(centre, half)
+    sea = Sea(comps, depth)
+    kr = sea.k * half.max()
+    tol = np.sum(sea.w ** 2 * sea.a * sea.factor(centre[2] + half[2]) * kr ** 2 / 6 * (1 + kr ** 2)) * RHO * vol
+    effect = ('[[bodies.b.effects]]\ntype = "riflex_body"\nname = "box"\n'
+              f'offset = [{centre[0]}, {centre[1]}, {centre[2]}]\nam = 0.0\nae = {vol!r}\n')
+    fmu, unzipped = built(tmp_path, scene_text(spectrum, depth, "none", {"c": where}, effects=effect))
+    steps = 200
+    names = [f"box.force[{i}]" for i in (1, 2, 3)] + [f"waves.c.acceleration[{i}]" for i in (1, 2, 3)]
+    fmu_rows = {f: Flavour(fmu, unzipped, f).outputs(names, steps) for f in ("python", "c")}
+    body = LumpedBody("box", centre, am=0.0, ae=vol)
+    env = Env(RHO, G, water=Water(WaveKinematics(comps, G, depth), ph, RHO))
+    buoyancy = RHO * G * vol * np.array([0.0, 0.0, 1.0])
+    for i in range(0, steps, 10):
+        t = (i + 1) * 0.01
+        rows = kin.at(ph.at(t), 1.0, pts, RHO)
+        assert np.all(rows[:, 7] > pts[:, 2])   # all wet
+        p = rows[:, 6] - RHO * G * pts[:, 2]
+        gauss = -(p * weights) @ normals
+        kernel = body.load(held(), env)[:3]
+        for got in [kernel] + [r[i, :3] for r in fmu_rows.values()] + \
+                [RHO * vol * r[i, 3:] + buoyancy for r in fmu_rows.values()]:
+            assert np.all(np.abs(got - gauss) <= tol), (t, got - gauss, tol)
+    assert tol < 0.01 * RHO * vol * sea.scale(0, 2, centre[2])   # a small body: kr ≲ 0.2
+    # the difference is the box's shape, of order (kr)²: a cube of the same volume feels ρ·V·a to (kr)⁴
+    cube = np.full(3, vol ** (1 / 3) / 2)
+    pts, normals, weights = box_surface(centre, cube)
+    rows = kin.at(ph.at(1.0), 1.0, pts, RHO)
+    gauss = -((rows[:, 6] - RHO * G * pts[:, 2]) * weights) @ normals
+    kc = sea.k * cube[0]
+    tol4 = np.sum(sea.w ** 2 * sea.a * sea.factor(centre[2] + cube[2]) * kc ** 4 / 10) * RHO * vol
+    ph.at(1.0)
+    assert np.all(np.abs(body.load(held(), env)[:3] - gauss) <= tol4) and tol4 < 0.05 * tol
