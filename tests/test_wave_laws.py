@@ -308,21 +308,21 @@ class Flavour:
             s.exitInitializationMode()
             self.set, self.get, self.step = s.setReal, s.getReal, s.doStep
 
-    def outputs(self, names, steps, heave=None):
-        """(steps, len(names)) of the outputs ``names`` after each step of H; ``heave``: the
-        body's position[3] set before each step (a sequence of ``steps``)."""
+    def outputs(self, names, steps, heave=None, dt=H):
+        """(steps, len(names)) of the outputs ``names`` after each step of ``dt``; ``heave``:
+        the body's position[3] set before each step (a sequence of ``steps``)."""
         refs = [self.vr[n] for n in names]
         out = np.empty((steps, len(names)))
         for i in range(steps):
             if heave is not None:
                 self.set([self.vr["position[3]"]], [float(heave[i])])
-            self.step(i * H, H)
+            self.step(i * dt, dt)
             out[i] = self.get(refs)
         return out
 
-    def record(self, names, steps, heave=None):
+    def record(self, names, steps, heave=None, dt=H):
         """{point name: (1, steps, 8)} of the named points' outputs (``outputs``)."""
-        out = self.outputs([f"waves.{n}.{c}" for n in names for c in OUTPUTS], steps, heave)
+        out = self.outputs([f"waves.{n}.{c}" for n in names for c in OUTPUTS], steps, heave, dt)
         return {n: out[None, :, 8 * j:8 * j + 8] for j, n in enumerate(names)}
 
 
