@@ -222,6 +222,9 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
                                                                   sea.depth if sea else math.inf)))
                     except WaveError as exc:
                         bad.append(f"{name}: {exc}")
+                    else:
+                        for message in _bem_laws(d, values, body, sea, rho, g):
+                            problems.warn(f"{where}.bem", message)
             else:
                 # a body away from the rotation centre has its centre of mass away too: said once, above
                 bad += _hydrostatic_problems(d, body, name, rotation, centre_said=fact in problems.facts)
@@ -259,6 +262,19 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
         except WaveError as exc:
             key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
             problems.add(key, f"{name} ({where}): {exc}")
+
+
+def _bem_laws(d, values, body, sea, rho, g):
+    """The warnings of decks/bem_laws.py for a wave_excitation effect's data ``d`` (its
+    transfer functions ``values``) against the radiation result of the same file (a WAMIT
+    .3 / .2: the .1 beside it): the Haskind relation and the long-wave phase."""
+    from ..decks import bem_laws
+    if sea is None:
+        return []
+    rho, g = rho or 1025.0, g or 9.81
+    radiation = bem_laws.radiation_of(d["bem"], d.get("ulen"), rho, g, d.get("period_variable"))
+    return bem_laws.excitation_problems(Path(d["bem"]).name, d["body"], np.asarray(d["omega"]), d["directions"],
+                                        values, body.position[:2], radiation, sea.depth, rho, g)
 
 
 def _drift_problems(problems, body):
