@@ -147,16 +147,20 @@ def test_submerged_column_loads_equal_theory_and_hydrodyn(tmp_path):
     assert np.allclose(closed[:, 2] + RHO * G * AREA * (hi - lo), plates, rtol=1e-9)   # Gauss
     closed[:, 2] = plates
     peer_cols = np.column_stack([ref["HydroFxi"], ref["HydroMyi"], ref["HydroFzi"]])[1:STEPS + 1]
-    for flavour in ("python", "c"):
-        got = ours("m_submerged", tmp_path, flavour).outputs(["force[1]", "force[5]", "force[3]"], STEPS, dt=DT)
+    runs = {}
+    for flavour, n in (("c", STEPS), ("python", STEPS // 5)):   # (the Python flavour: 2 s, 40 slices cost)
+        got = runs[flavour] = ours("m_submerged", tmp_path, flavour).outputs(["force[1]", "force[5]", "force[3]"], n,
+                                                                              dt=DT)
         for i, f in enumerate((fx, my, fz)):
             mid = midpoint_bound(f, lo, hi, t[::10])
             interp = INTERPOLATION * np.abs(closed[:, i]).max()
-            assert np.all(np.abs(got[:, i] - closed[:, i]) <= mid), (flavour, i)
+            assert np.all(np.abs(got[:, i] - closed[:n, i]) <= mid), (flavour, i)
             assert np.all(np.abs(peer_cols[:, i] - closed[:, i]) <= 2 * mid + interp), i
-            assert np.all(np.abs(got[:, i] - peer_cols[:, i]) <= 3 * mid + interp), (flavour, i)
-        crest = np.argmin(np.abs(t - 8.0))   # the vertical FK at the crest: the plate under less water
-        assert got[crest, 2] - RHO * G * AREA * (hi - lo) < -3e4 and peer_cols[crest, 2] < got[0, 2]
+            assert np.all(np.abs(got[:, i] - peer_cols[:n, i]) <= 3 * mid + interp), (flavour, i)
+    # at the crest (t = 8 s) the top plate, under more water, pushes down: −33.0 kN of FK
+    crest = int(np.argmin(np.abs(t - 8.0)))
+    fk = runs["c"][crest, 2] - RHO * G * AREA * (hi - lo)
+    assert -3.31e4 < fk < -3.29e4 and abs(peer_cols[crest, 2] - RHO * G * AREA * (hi - lo) - fk) < 10.0
 
 
 @pytest.mark.parametrize("case", ["m_inertia", "m_drag_current"])

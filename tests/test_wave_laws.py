@@ -342,13 +342,12 @@ def built(tmp, text):
 
 # each spectrum, stretching and depth once (the kernel test above takes every combination)
 FMU_CASES = [("regular", "none", math.inf), ("jonswap", "vertical", 40.0),
-             ("pierson_moskowitz", "extrapolation", 8.0), ("spread", "wheeler", 40.0),
-             ("jonswap", "wheeler", math.inf)]
+             ("pierson_moskowitz", "extrapolation", 8.0), ("spread", "wheeler", 40.0)]
 
 
 @pytest.mark.parametrize("spectrum, stretching, depth", FMU_CASES)
 def test_fmu_outputs_obey_the_laws(spectrum, stretching, depth, tmp_path):
-    """The load FMU's waves.NAME.* outputs, both flavours, 4 s at steps of H: every law by
+    """The load FMU's waves.NAME.* outputs, both flavours, 3 s at steps of H: every law by
     finite differences of the outputs themselves (Wheeler's surface: a point on the body,
     its heave input set to the elevation the FMU gave there in a first run); both flavours'
     records agree to 1e-10 of their scale."""
@@ -356,7 +355,7 @@ def test_fmu_outputs_obey_the_laws(spectrum, stretching, depth, tmp_path):
     fmu, unzipped = built(tmp_path, scene_text(spectrum, depth, stretching, pts, surface=(12.0, -7.0)))
     comps = waves.components(sea_state(spectrum, depth, stretching))
     sea = Sea(comps, depth)
-    steps = 400
+    steps = 300
     records = {}
     for flavour in ("python", "c"):
         fm = Flavour(fmu, unzipped, flavour)

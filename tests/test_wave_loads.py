@@ -297,7 +297,7 @@ def test_froude_krylov_on_a_small_body_is_rho_v_a(spectrum, depth, tmp_path):
     effect = ('[[bodies.b.effects]]\ntype = "riflex_body"\nname = "box"\n'
               f'offset = [{centre[0]}, {centre[1]}, {centre[2]}]\nam = 0.0\nae = {vol!r}\n')
     fmu, unzipped = built(tmp_path, scene_text(spectrum, depth, "none", {"c": where}, effects=effect))
-    steps = 200
+    steps = 100
     names = [f"box.force[{i}]" for i in (1, 2, 3)] + [f"waves.c.acceleration[{i}]" for i in (1, 2, 3)]
     fmu_rows = {f: Flavour(fmu, unzipped, f).outputs(names, steps) for f in ("python", "c")}
     body = LumpedBody("box", centre, am=0.0, ae=vol)
