@@ -28,6 +28,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from airy import wave_number
+
 PEER = Path(__file__).parent / "data" / "peers" / "hydrodyn"
 RHO, G, DEPTH, A_WAVE, W = 1025.0, 9.81, 200.0, 2.0, 2 * math.pi / 8.0
 R, AREA, DZ, CM, CD, U = 1.0, math.pi, 0.5, 2.0, 0.7, 0.5
@@ -43,14 +45,7 @@ def peer(case):
     return {n: rows[:, i] for i, n in enumerate(names)}
 
 
-def wave_number():
-    k = W * W / G
-    for _ in range(50):
-        k -= (G * k * math.tanh(k * DEPTH) - W * W) / (G * math.tanh(k * DEPTH) + G * k * DEPTH / math.cosh(k * DEPTH) ** 2)
-    return k
-
-
-K = wave_number()
+K = float(wave_number(W, DEPTH))
 
 
 def airy(z, t):

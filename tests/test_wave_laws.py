@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from airy import wave_number
 from hydrofmu.physics import waves
 from hydrofmu.physics.wave_kinematics import WaveKinematics
 from hydrofmu.physics.waves import Phasors, SeaState
@@ -68,24 +69,12 @@ SEAS = {   # [waves] lines of each spectrum (ramp 0: the laws hold from the firs
 DEPTHS = (math.inf, 40.0, 8.0)   # deep, finite, shallow-ish (kh ≈ 0.6–1.5 over the spectra)
 
 
-def wave_numbers(omega, depth):
-    """k of ω² = g·k·tanh(k·h) by Newton's method (written here, not the code's solver)."""
-    k = omega ** 2 / G
-    if math.isinf(depth):
-        return k
-    k = k / np.sqrt(np.tanh(k * depth))
-    for _ in range(50):
-        f = G * k * np.tanh(k * depth) - omega ** 2
-        k = k - f / (G * np.tanh(k * depth) + G * k * depth / np.cosh(k * depth) ** 2)
-    return k
-
-
 class Sea:
     """What the bounds need of a sea's components: amplitude, ω, k, the depth."""
 
     def __init__(self, comps, depth):
         self.a, self.w, self.depth = comps.amplitude, comps.omega, depth
-        self.k = wave_numbers(self.w, depth)
+        self.k = wave_number(self.w, depth)   # (tests/airy.py's, not the code's solver)
 
     def factor(self, z):
         """The Airy depth factor F_h = cosh k(z + h)/sinh kh (deep: e^{kz}) of each component
