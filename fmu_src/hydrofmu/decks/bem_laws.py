@@ -35,7 +35,7 @@ import numpy as np
 MAX_GAP = 45.0         # deg: the largest heading gap the integral takes (trapezoid exact to the 7th harmonic)
 DECOUPLED = 0.03       # a coupling this small against √(peak B_ii·peak B_jj) is the panels' noise
 DEAD = 1e-6            # a dof whose damping peaks below this of its kind's largest radiates nothing
-RESOLVED = 1e-2        # |X(β)|²'s top harmonics on the heading grid below this of its mean: resolved
+RESOLVED = 0.03        # |X(β)|²'s top harmonics on the heading grid below this of its mean: resolved
 TOLERANCE = 0.10       # of √(peak B_ii·peak B_jj): the Haskind misfit allowed (clean datasets: ≤ 4.5 %)
 EVEN = {"xz": (1, 3, 5), "yz": (2, 3, 4)}   # the dofs (1…6) even under each plane's reflection
 SIGN = {"xz": np.array([1, -1, 1, -1, 1, -1]), "yz": np.array([-1, 1, 1, 1, -1, -1])}
@@ -126,15 +126,19 @@ def haskind(omega, directions, values, position, damping_omega, damping, depth, 
     omega = np.asarray(omega, float)
     keep = (omega >= damping_omega[0]) & (omega <= damping_omega[-1])
     omega, values = omega[keep], np.asarray(values)[keep]
+    if omega.size == 0:
+        return None
     k = np.asarray(wave_number(omega, g, depth), float)
     found = around(values, directions, omega, k, position, sym)
-    if found is None or omega.size == 0:
+    if found is None:
         return None
     h, x = found
     gaps = np.diff(np.r_[h, h[0] + 360.0])
     if np.ptp(gaps) < 1e-6 and h.size > 3:   # a uniform grid: keep the frequencies it resolves
         f = np.abs(np.fft.rfft(np.abs(x) ** 2, axis=1))
         top = f[:, -2:].max(axis=1) / np.where(f[:, 0] > 0, f[:, 0], 1.0)
+        # (not yaw: a doubly symmetric body's |X_6|² ∝ sin²2β holds the 45° grid's top
+        # harmonic itself, which the trapezoid integrates exactly)
         ok = np.all(top[:, :5][:, alive(damping)[:5]] <= RESOLVED, axis=-1)
         omega, k, x = omega[ok], k[ok], x[ok]
         if omega.size == 0:
