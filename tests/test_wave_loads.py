@@ -231,7 +231,7 @@ def test_joined_barges_clump_with_and_without_waves(tmp_path):
     uc = np.array([math.cos(math.radians(10.0)), math.sin(math.radians(10.0)), 0.0])
     cd, am, ae, added = np.array(clump["cd"]), clump["am"], clump["ae"], np.array(clump["added_mass"])
     got, want = [], []
-    for i, t in enumerate(r.time):
+    for i, t in list(enumerate(r.time))[::3]:   # (every third sample: the reference costs 1 ms)
         x, att, v = (np.array([r[f"barge_a_dynamics.{q}[{j}]"][i] for j in range(1, n + 1)])
                      for q, n in (("position", 3), ("attitude", 3), ("velocity", 6)))
         off = rotation(att) @ np.array(clump["offset"])
