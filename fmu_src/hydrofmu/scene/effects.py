@@ -179,7 +179,7 @@ def _wave_excitation(problems, table, where):
     return {"bem": str(path), "body": body, "kind": data.kind, "omega": data.omega.tolist(),
             "directions": data.directions.tolist(), "re": x.real.tolist(), "im": x.imag.tolist(),
             "rotation_center": data.rotation_centers.get(body), "rho": data.rho, "g": data.g,
-            "water_depth": data.water_depth}
+            "water_depth": data.water_depth, "ulen": table.get("ulen"), "period_variable": table.get("period_variable")}
 
 
 def _bem_hydrostatics(problems, table, where):

@@ -106,7 +106,7 @@ def _load_scene(path, overrides=None):
                                 {"rho": rho, "g": g, "depth": sea.depth if sea is not None else None})
                  if "couplings" in doc else [])
     speed, direction, profile = read_current(p, env)
-    points = read_wave_points(p, doc["waves"], bodies) if "waves" in doc else {}
+    points = read_wave_points(p, doc["waves"], bodies, sea) if "waves" in doc else {}
     feels = bool(points) or bool(joints) or any(feels_waves(e) for b in bodies.values() for e in b.effects)
     check_wave_effects(p, bodies, sea, rho, g, feels)
     moorings = read_moorings(p, doc["moorings"], bodies, p.env, sea) if "moorings" in doc else {}

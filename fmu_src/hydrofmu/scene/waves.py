@@ -97,9 +97,10 @@ def feels_waves(effect):
     return effect.data is not None and (effect.type == "riflex_body" or bool(effect.data.get("waves")))
 
 
-def read_wave_points(problems, table, bodies):
+def read_wave_points(problems, table, bodies, sea=None):
     """``[waves.points.NAME]``: {name: {"position": global (3)} or {"body": name, "offset": (3)}},
-    in the file's order; each name an identifier (it prefixes FMU variables)."""
+    in the file's order; each name an identifier (it prefixes FMU variables).  With the sea
+    state ``sea``, a point never in the water is a warning (``_dry_point``)."""
     from .problems import identifier
     raw = table.get("points", {}) if isinstance(table, dict) else {}
     if not isinstance(raw, dict):
@@ -133,7 +134,47 @@ def read_wave_points(problems, table, bodies):
             continue
         if body is not None and offset is not None:
             points[name] = {"body": body, "offset": offset}
+    if sea is not None:
+        for name, point in points.items():
+            _dry_point(problems, f"waves.points.{name}", point, bodies, sea)
     return points
+
+
+# a spectrum's crests exceed this many Hs with probability exp(−8·3²) = e^{−72} per wave
+# (linear crests are Rayleigh distributed, P(η_c > x) = exp(−8x²/Hs²))
+CREST_HS = 3.0
+
+
+def _dry_point(problems, where, point, bodies, sea):
+    """A warning for a named point that is never in the water (its outputs always 0): below
+    the bed, or above the highest crest the scene's sea reaches — Σ a_k, what the linear sea
+    can sum to at most (a regular wave's H/2), and for a spectrum 3·Hs, which a crest passes
+    with probability e^{−72}.  A point on a body is judged at the body's initial pose."""
+    from ..physics.kinematics import rotation
+    from ..physics.waves import WaveError, components
+    if "position" in point:
+        z, key, at = point["position"][2], f"{where}.position", ""
+    else:
+        body = bodies[point["body"]]
+        if body.position is None or body.attitude is None:
+            return
+        z = float(body.position[2] + (rotation(body.attitude) @ np.asarray(point["offset"], float))[2])
+        key, at = f"{where}.offset", f" at the initial pose of body {point['body']!r}"
+    if z < -sea.depth:
+        problems.warn(key, f"z = {z:g} m{at} is below the sea bed (waves.depth = {sea.depth:g} m): the point is never "
+                           "in the water, its outputs stay 0")
+        return
+    try:
+        crest = float(np.sum(components(sea).amplitude))
+    except WaveError:
+        return   # said by the effects' checks
+    why = "the sum of the components' amplitudes, which the linear sea never exceeds"
+    if sea.spectrum != "regular" and CREST_HS * sea.hs < crest:
+        crest, why = CREST_HS * sea.hs, (f"{CREST_HS:g}·Hs: a crest passes it with probability e^{{−72}} per wave "
+                                         "(Rayleigh crests)")
+    if z > crest:
+        problems.warn(key, f"z = {z:g} m{at} is above the highest crest of the scene's sea ({crest:.3g} m: {why}): "
+                           "the point is never in the water, its outputs stay 0")
 
 
 def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
@@ -181,6 +222,9 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
                                                                   sea.depth if sea else math.inf)))
                     except WaveError as exc:
                         bad.append(f"{name}: {exc}")
+                    else:
+                        for message in _bem_laws(d, values, body, sea, rho, g):
+                            problems.warn(f"{where}.bem", message)
             else:
                 # a body away from the rotation centre has its centre of mass away too: said once, above
                 bad += _hydrostatic_problems(d, body, name, rotation, centre_said=fact in problems.facts)
@@ -218,6 +262,19 @@ def check_wave_effects(problems, bodies, sea, rho, g, feels=False):
         except WaveError as exc:
             key = "waves.spreading" if exc.field == "spreading" else f"{where}.bem"
             problems.add(key, f"{name} ({where}): {exc}")
+
+
+def _bem_laws(d, values, body, sea, rho, g):
+    """The warnings of decks/bem_laws.py for a wave_excitation effect's data ``d`` (its
+    transfer functions ``values``) against the radiation result of the same file (a WAMIT
+    .3 / .2: the .1 beside it): the Haskind relation and the long-wave phase."""
+    from ..decks import bem_laws
+    if sea is None:
+        return []
+    rho, g = rho or 1025.0, g or 9.81
+    radiation = bem_laws.radiation_of(d["bem"], d.get("ulen"), rho, g, d.get("period_variable"))
+    return bem_laws.excitation_problems(Path(d["bem"]).name, d["body"], np.asarray(d["omega"]), d["directions"],
+                                        values, body.position[:2], radiation, sea.depth, rho, g)
 
 
 def _drift_problems(problems, body):
