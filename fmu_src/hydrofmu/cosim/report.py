@@ -221,7 +221,9 @@ def _whole(ax, t, block, split, long):
         ax.axhline(mean, color=colour, lw=0.8, ls="--", alpha=0.8)
         drawn.append((ts, slow))
     grid = np.linspace(t[0], t[-1], 2 * BINS) if t.size else t
-    lo, hi, clipped = robust_limits(grid, [np.interp(grid, ts, y) for ts, y in drawn])
+    # loads: a start transient does not set the axis; motion: its largest value is the news
+    lo, hi, clipped = robust_limits(grid, [np.interp(grid, ts, y) for ts, y in drawn], factor=3.0 if not block.stats
+                                    else np.inf)
     ax.set_ylim(lo, hi)
     title = block.title
     if clipped:
@@ -282,7 +284,7 @@ def blocks(result, manifest):
                              stats=True))
         pos, att = result.motion(body, "position", 3), result.motion(body, "attitude", 3)
         dpos, datt = relative_motion(pos, att)
-        motion = ((dpos, "m", pos[0], "{:g}"), (np.degrees(datt), "deg", np.degrees(att[0]), "{:.3g}"))
+        motion = ((dpos, "m", pos[0], "{:.4g}"), (np.degrees(datt), "deg", np.degrees(att[0]), "{:.3g}"))
         skipped = []
         for k, (values, unit, start, fmt) in enumerate(motion):
             scale = float(np.nanmax(np.abs(values))) if values.size else 0.0
@@ -310,6 +312,8 @@ def blocks(result, manifest):
                     skipped.append(f"{LOAD_NAMES[i]} ≤ {max(small.values()):.2g} {unit}")
                     continue
                 curves = [(e, colours[e], x, e == TOTAL) for e, x in loads.items() if not negligible(small[e], scale)]
+                skipped += [f"{LOAD_NAMES[i]} of {e} ≤ {p:.2g} {unit}" for e, p in small.items()
+                            if negligible(p, scale)]
                 large, rest = by_scale(curves)
                 out.append(Block(f"{body}: {LOAD_NAMES[i]}", unit, large))
                 if rest:   # one curve alone on its axis: its envelope too
