@@ -245,10 +245,11 @@ def _window(ax, t, block, seconds):
 def _stats_text(ax, x, dt, split, unit):
     from .statistics import describe
     d = describe(x, dt, split)
-    parts = [f"mean {d['mean']:.3g}"]
-    if split:
-        parts += [f"LF σ {d['lf_std']:.3g}", f"WF σ {d['wf_std']:.3g}"]
-    parts += [f"MPM {d['mpm_min']:.3g} … {d['mpm_max']:.3g} {unit}"]
+    parts = [f"mean {d['mean']:.3g}"] + ([f"LF σ {d['lf_std']:.3g}", f"WF σ {d['wf_std']:.3g}"] if split
+                                         else [f"σ {d['std']:.3g}"])
+    if np.isfinite(d["mpm_min"]) and np.isfinite(d["mpm_max"]):   # a record of too few peaks has none
+        parts += [f"MPM {d['mpm_min']:.3g} … {d['mpm_max']:.3g}"]
+    parts[-1] += f" {unit}"
     ax.text(0.01, 0.97, ", ".join(parts), transform=ax.transAxes, va="top", ha="left", fontsize=7.5,
             bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.8", alpha=0.85))
 
@@ -334,7 +335,8 @@ def blocks(result, manifest):
 
 
 def plot(result, manifest, path, split=None):
-    """Write a PNG of a run: one `blocks` panel pair per quantity, two to a row.
+    """Write a PNG of a run: one panel per `blocks` quantity, three to a row (a long record: a
+    pair of panels per quantity, two pairs to a row).
 
     A record longer than ``LONG_PERIODS`` peak periods of the scene's sea draws, per quantity,
     the whole run as each curve's min–max envelope (every sample counted, in ``BINS`` bins)
@@ -360,10 +362,10 @@ def plot(result, manifest, path, split=None):
     window = WINDOW_PERIODS * tp if long else None
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
     items, left = blocks(result, manifest)
-    per_row = 2
+    per_row = 2 if long else 3   # a long record's quantities take two panels each
     rows = max(1, -(-len(items) // per_row))
     width = [2.3, 1.0] * per_row if long else [1.0] * per_row
-    fig = plt.figure(figsize=(16, 2.5 * rows + 1.3 + 0.18 * len(left)))
+    fig = plt.figure(figsize=(16, (2.5 if long else 2.8) * rows + 1.3 + 0.18 * len(left)))
     grid = fig.add_gridspec(rows, len(width), width_ratios=width, hspace=0.75, wspace=0.28)
     for k, block in enumerate(items):
         r, c = divmod(k, per_row)
