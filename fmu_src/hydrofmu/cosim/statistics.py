@@ -8,8 +8,9 @@ A record is n samples x_k = x(t_k) at a constant step dt [s].
   a mooring's slow drift and the waves; JONSWAP holds ~1e-9 of its peak density there):
   x = x̄ + x_LF + x_WF.  x − x̄ followed by itself reversed (a record whose periodic
   extension is continuous: no jump between its end and its start leaks into every
-  frequency) is transformed (FFT); its lines below f_s, inverse transformed, are x_LF over
-  the record (zero phase: a brick wall, no lag); x_WF is the rest.  Both have zero mean.
+  frequency), then held at its first value up to a length FFTs are fast at, is transformed
+  (FFT); its lines below f_s, inverse transformed, are x_LF over the record (zero phase: a
+  brick wall, no lag); x_WF is the rest.
 - **Zero up-crossings** of a zero-mean part y: the k with y_k < 0 ≤ y_{k+1}, at the
   interpolated time; T_z = the mean spacing of the crossings; N = record / T_z cycles.
 - **WF extreme, Rayleigh**: the WF part as a narrow-band Gaussian process, whose peaks are
@@ -65,10 +66,25 @@ def parts(x, dt, period):
     n = y.size
     if n < 3 or period is None or not math.isfinite(period):
         return mean, y, np.zeros_like(y)
-    spectrum = np.fft.rfft(np.concatenate([y, y[::-1]]))   # the mirrored record: continuous when repeated
-    spectrum[np.fft.rfftfreq(2 * n, dt) >= 1.0 / period] = 0.0
-    low = np.fft.irfft(spectrum, 2 * n)[:n]
+    m = fast_length(2 * n)   # the mirrored record, held at its first value up to a length FFTs are fast at
+    spectrum = np.fft.rfft(np.concatenate([y, y[::-1], np.full(m - 2 * n, y[0])]))
+    spectrum[np.fft.rfftfreq(m, dt) >= 1.0 / period] = 0.0
+    low = np.fft.irfft(spectrum, m)[:n]
     return mean, low, y - low
+
+
+def fast_length(n):
+    """The smallest 2^a·3^b·5^c ≥ n (an FFT of a length with a large prime factor is many
+    times slower: 216 002 points took 50 ms, 216 000 take 3 ms)."""
+    best, p5 = 2 * n, 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            p = p35 * (1 << max(0, (-(-n // p35) - 1).bit_length()))   # the power of 2 taking p35 to ≥ n
+            best = min(best, p)
+            p35 *= 3
+        p5 *= 5
+    return best
 
 
 def upcrossings(y, dt=1.0):
