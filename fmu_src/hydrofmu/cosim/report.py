@@ -1,10 +1,14 @@
-"""Plots of a run: per body, its motion from the initial pose and every load on it (forces
-and moments, one colour per effect in the whole figure); per joint, its gap, relative
-rotation and force.
+"""Plots of a run: per body, its wave elevation, each dof of its motion from the initial pose
+and each load component with every effect on it (one colour per effect in the whole
+figure); per joint, its gap, relative rotation and force; the response spectra.
 
 Data choices, kept in plain functions (tested on synthetic series):
 - motion is shown relative to the initial pose (`relative_motion`): a body moored at
   x = 100 m moves by metres, which an absolute axis from 0 to 100 m hides;
+- a long record is its whole-run min–max envelope (every sample) under its mean and slow
+  part, beside its last peak periods (`plot`); each quantity on its own axis, the small loads
+  of a component on one of their own (`by_scale`), negligible ones named, not drawn
+  (`negligible`);
 - load axes follow the settled part of the run (`robust_limits`): a start transient many
   times larger than the rest is clipped, and the panel says so and gives its range.
 """
@@ -12,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-LINESTYLES = ("-", "--", ":")   # component x / y / z (Fx / Fy / Fz, Mx / My / Mz, roll / pitch / yaw)
 TOTAL = "total"
 
 
@@ -140,6 +143,7 @@ ELEVATION = "#3b75af"               # the wave elevation at the body
 BINS = 500                # a long record's whole-run panel: the min–max envelope in this many bins
 WINDOW_PERIODS = 8        # its window panel: the last 8 peak periods of the sea, every sample
 LONG_PERIODS = 40         # a record longer than 40 peak periods plots as envelope + window
+SHORT_ROWS = 8000         # a short record's line: at most this many samples (every k-th)
 SMALL = 0.05              # loads under 5 % of a panel's largest get a panel of their own scale
 NEGLIGIBLE = 1e-3         # a dof or load at most 0.1 % of the body's largest of its kind is listed, not drawn
 FLOOR = 1e-9              # ... as is one at most 1e-9 (m, deg, kN, kN·m) whatever the others
@@ -180,7 +184,8 @@ def by_scale(curves, ratio=SMALL):
 class Block:
     """One quantity of the figure: its curves [(label, colour, values in the plot's unit,
     band)] over the run; ``band``: its min–max envelope is drawn in a long record's
-    whole-run panel (else only its mean + LF line)."""
+    whole-run panel (else only its mean + LF line); ``stats``: a single motion-like curve,
+    its figures written in the panel and its axis never clipped."""
 
     def __init__(self, title, unit, curves, stats=False):
         self.title, self.unit, self.curves, self.stats = title, unit, curves, stats
@@ -206,7 +211,7 @@ def _whole(ax, t, block, split, long):
     drawn = []   # (t [s], values) of every line and envelope edge: what the axis must show
     for name, colour, x, band in block.curves:
         if not long:
-            ts, xs = _stride(t, 4 * BINS * 4), _stride(x, 4 * BINS * 4)
+            ts, xs = _stride(t, SHORT_ROWS), _stride(x, SHORT_ROWS)
             ax.plot(ts * scale, xs, color=colour, lw=1.0, label=name)
             drawn.append((ts, xs))
             continue
@@ -297,7 +302,7 @@ def blocks(result, manifest):
                 out.append(Block(f"{body}: {DOFS[k][i]} from {fmt.format(start[i])} {unit}", unit,
                                  [(DOFS[k][i].split()[0], DOF_COLOURS[i], values[:, i], True)], stats=True))
         sources = load_sources(result, manifest, body)
-        for kind, (first, unit) in enumerate(((0, "kN"), (3, "kN·m"))):
+        for first, unit in ((0, "kN"), (3, "kN·m")):   # forces, then moments: each kind its own scale
             comps = {}
             for i in range(first, first + 3):
                 loads = {e: result[f"{inst}.{name}[{i + 1}]"] / 1e3 for e, (inst, name) in sources.items()}
@@ -306,14 +311,14 @@ def blocks(result, manifest):
                 comps[i] = loads
             scale = max((float(np.nanmax(np.abs(x))) for loads in comps.values() for x in loads.values()), default=0.0)
             for i, loads in comps.items():
-                small = {e: float(np.nanmax(np.abs(x))) for e, x in loads.items()}
+                peaks = {e: float(np.nanmax(np.abs(x))) for e, x in loads.items()}
                 if not loads:
                     continue
-                if all(negligible(p, scale) for p in small.values()):
-                    skipped.append(f"{LOAD_NAMES[i]} ≤ {max(small.values()):.2g} {unit}")
+                if all(negligible(p, scale) for p in peaks.values()):
+                    skipped.append(f"{LOAD_NAMES[i]} ≤ {max(peaks.values()):.2g} {unit}")
                     continue
-                curves = [(e, colours[e], x, e == TOTAL) for e, x in loads.items() if not negligible(small[e], scale)]
-                skipped += [f"{LOAD_NAMES[i]} of {e} ≤ {p:.2g} {unit}" for e, p in small.items()
+                curves = [(e, colours[e], x, e == TOTAL) for e, x in loads.items() if not negligible(peaks[e], scale)]
+                skipped += [f"{LOAD_NAMES[i]} of {e} ≤ {p:.2g} {unit}" for e, p in peaks.items()
                             if negligible(p, scale)]
                 large, rest = by_scale(curves)
                 out.append(Block(f"{body}: {LOAD_NAMES[i]}", unit, large))
