@@ -371,7 +371,7 @@ def plot(result, manifest, path, split=None):
     rows = max(1, -(-len(items) // per_row))
     width = [2.3, 1.0] * per_row if long else [1.0] * per_row
     fig = plt.figure(figsize=(16, (2.5 if long else 2.8) * rows + 1.3 + 0.18 * len(left)))
-    grid = fig.add_gridspec(rows, len(width), width_ratios=width, hspace=0.75, wspace=0.28)
+    grid = fig.add_gridspec(rows, len(width), width_ratios=width, hspace=0.7 if long else 0.55, wspace=0.28)
     for k, block in enumerate(items):
         r, c = divmod(k, per_row)
         ax = fig.add_subplot(grid[r, c * (2 if long else 1)])
