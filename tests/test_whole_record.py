@@ -156,3 +156,25 @@ def test_the_plot_of_a_long_record_is_one_a_report_can_take(tmp_path, monkeypatc
     for named in ("sway y ≤ ", "roll ≤ ", "yaw ≤ 0 deg", "Fy of drift ≤ 0 kN", "Mz of drift ≤ 5e-05 kN·m"):
         assert named in footer, footer
     assert fig.get_size_inches()[0] * fig.dpi == 1600
+
+
+def test_the_split_is_a_scene_key_and_a_command_line_option(tmp_path, demo_build, capsys):
+    """[run] split is read (not a run knob: no rebuild, not in `set`), a bad one is named by its
+    key path; --split is checked before anything runs (exit 2, one line)."""
+    from conftest import MODELS
+    from hydrofmu.cli import main
+    from hydrofmu.cosim.summary import split_period
+    from hydrofmu.errors import InputError
+    from hydrofmu.scene import load_scene
+    text = (MODELS / "moored_barge.toml").read_text().replace('"decks/', f'"{MODELS}/decks/')
+    scene = tmp_path / "s.toml"
+    scene.write_text(text.replace("substep = 0.02", "substep = 0.02\nsplit = 30.0"))
+    run = load_scene(scene).run
+    assert run["split"] == 30.0 and "split" not in run["set"]
+    assert split_period({"run": run}) == {"period": 30.0, "from": "[run] split"}
+    scene.write_text(text.replace("substep = 0.02", "substep = 0.02\nsplit = -1.0"))
+    with pytest.raises(InputError, match=r"run\.split"):
+        load_scene(scene)
+    assert main(["run", str(demo_build), "--split", "0", "--stop", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--split: must be a period > 0 [s], found 0" in err
