@@ -1,11 +1,11 @@
 """The analyst's statistics of one response record: its mean, its low-frequency (LF) and
 wave-frequency (WF) parts with their standard deviations, the expected extremes of the
-record's duration and its response spectrum (pure numpy and scipy; docs/running.md).
+record's duration and its response spectrum (numpy only; docs/running.md).
 
 A record is n samples x_k = x(t_k) at a constant step dt [s].
 
 - **Split** at the period T_s [s] (the default 2·Tp of the scene's sea: f_s = f_p/2, between
-  a mooring's slow drift and the waves; JONSWAP holds ~1e-9 of its peak density there):
+  a mooring's slow drift and the waves; a JONSWAP spectrum (γ 3.3) is 7e-8 of its peak there):
   x = x̄ + x_LF + x_WF.  x − x̄ followed by itself reversed (a record whose periodic
   extension is continuous: no jump between its end and its start leaks into every
   frequency), then held at its first value up to a length FFTs are fast at, is transformed
