@@ -76,7 +76,9 @@ class Sphere(Fmi2Slave):
 
 def airy(comps, t, x, y, z, g=9.81, ramp=20.0):
     """Deep-water Airy horizontal and vertical velocity of the components, Wheeler-stretched
-    (z' = z − η), ramped: the independent check of what the second FMU was given."""
+    (z' = z − η), ramped: the independent check of what the second FMU was given.  Per
+    component η = a·cos θ, θ = ωt − k·x + φ: u = aω·e^{kz'}·cos θ along the wave, and
+    w = ∂η/∂t at the surface = −aω·e^{kz'}·sin θ."""
     k = comps.omega ** 2 / g
     b = np.radians(comps.direction)
     th = comps.omega * t - k * (x * np.cos(b) + y * np.sin(b)) + comps.phase

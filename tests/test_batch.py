@@ -241,8 +241,15 @@ def test_capsized_and_the_linear_range_in_the_table(client, tmp_path):
                      '[[cases]]\n"run.load_hold" = "constant"\n"run.stop" = 100.0\n'
                      '[[cases]]\n"run.load_hold" = "linear"\n'
                      '[[cases]]\n"bodies.cyl.velocity" = [0.0, 0.0, 0.0, 0.0, 0.5, 0.0]\n')
-    table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False)
+    said = []
+    table = hydrofmu.run_batch(cases, tmp_path / "out", client=client, progress=False, log=said.append)
     assert list(table["status"]) == ["failed", "ok", "ok"], table[["status", "error"]]
+    # the workers' warnings come back named by their case (id and knobs as the file wrote them)
+    out_of_range = [line for line in said if "left the linear range" in line]
+    assert len(out_of_range) == 2, said
+    assert out_of_range[1].startswith(f"warning: case {table['case'].iloc[2][:8]} (bodies.cyl.velocity = "
+                                      "[0.0, 0.0, 0.0, 0.0, 0.5, 0.0]): [WARNING] cyl_dynamics: left the linear range")
+    assert "left the linear range" in table["warnings"].iloc[2] and table["warnings"].iloc[1] == ""
     assert table["error"].iloc[0].startswith("capsized: ") and "GimbalLock" not in table["error"].iloc[0]
     assert list(table["linear_range"]) == [False, True, False]
     w = pitch_frequency()

@@ -78,8 +78,30 @@ def test_libcosim_honours_the_scenes_outputs_and_interval(tmp_path):
     mine, theirs = read_parquet(tmp_path / "fmpy.parquet"), read_parquet(tmp_path / "libcosim.parquet")
     assert theirs.columns == mine.columns and theirs.units == mine.units and len(theirs) == 5
     assert theirs.manifest["scene"] == "moored_barge" and theirs.settings["algorithm"] == "jacobi"
+
     np.testing.assert_allclose(theirs.values, mine.values, rtol=1e-9, atol=1e-9)
     with pytest.raises(InputError, match=r"thin.toml.*run.interval.*ECCO chooses its own time points"):
         libcosim.run(built, stop=2.0, algorithm="ecco")
     with pytest.raises(InputError, match="interval: the output interval must be a whole number of steps"):
         libcosim.run(built, stop=2.0, algorithm="jacobi", interval=0.25)
+
+
+def test_each_engine_writes_its_own_files(demo_build, tmp_path):
+    """`hydrofmu run --engine libcosim` beside an fmpy run of the same build: its CSV, Parquet,
+    PNG, summary and spectra are <folder>.libcosim.* and leave the fmpy run's <folder>.* alone."""
+    import json
+    import shutil
+    from hydrofmu.cli import main
+    from hydrofmu.cosim.result import read_csv
+    folder = tmp_path / demo_build.name
+    shutil.copytree(demo_build, folder)
+    suffixes = (".csv", ".parquet", ".png", ".summary.json", ".spectra.csv", ".spectra.png")
+    for suffix in suffixes:   # an fmpy run's files, as `hydrofmu run` left them
+        folder.with_name(folder.name + suffix).write_text("the fmpy run's")
+    assert main(["run", str(folder), "--engine", "libcosim", "--algorithm", "jacobi", "--stop", "2"]) == 0
+    for suffix in suffixes:
+        assert folder.with_name(folder.name + suffix).read_text() == "the fmpy run's", suffix
+        assert folder.with_name(folder.name + ".libcosim" + suffix).stat().st_size > 0, suffix
+    assert read_csv(folder.with_name(folder.name + ".libcosim.csv")).manifest["scene"] == "moored_barge"
+    summary = json.loads(folder.with_name(folder.name + ".libcosim.summary.json").read_text())
+    assert summary["points"] == 21 and "lf_std" in summary["bodies"]["barge"]["position"]["x"]

@@ -33,21 +33,20 @@ def test_demo_outside_the_repository_finds_its_scenes_or_says_what_to_do(tmp_pat
     assert not (tmp_path / "build").exists()
 
 
-def test_plot_panels_say_zero_and_clipping_where_they_cover_nothing():
+def test_plot_panels_say_clipping_where_they_cover_nothing():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    from hydrofmu.cosim.report import _panel
+    from hydrofmu.cosim.report import Block, _whole
     t = np.linspace(0, 100, 1001)
-    fig, (zero, clipped) = plt.subplots(1, 2)
-    _panel(zero, t, [("drag", 2, np.zeros_like(t)), ("total", 2, np.zeros_like(t))], "yaw moment Mz [kN·m]", {})
-    assert [x.get_text() for x in zero.texts] == ["zero throughout"] and list(zero.get_yticks()) == [0]
+    fig, clipped = plt.subplots()
     spike = np.where(t < 2, -700.0, 50.0 + np.sin(t))
-    _panel(clipped, t, [("drag", 0, spike)], "Fx [kN]", {})
+    _whole(clipped, t, Block("Fx", "kN", [("drag", "C0", spike, False)]), None, False)
     assert not clipped.texts                                   # no box over the data or the ticks
-    title = clipped.get_title()
-    assert title.startswith("Fx [kN]\naxis clipped to the settled run; data span -700") and clipped.get_ylim()[0] > -700
+    title = clipped.get_title(loc="left")
+    assert title.startswith("Fx\naxis clipped to the settled run; data span -700") and clipped.get_ylim()[0] > -700
+    assert clipped.get_ylabel() == "[kN]"
     plt.close(fig)
 
 
@@ -76,7 +75,7 @@ def test_batch_polar_plot_has_units_and_one_legend_off_the_panels(tmp_path, monk
     plot(pd.DataFrame(rows), batch, tmp_path / "cases.png", {"barge.force[1]": "N"})
     (fig,) = figs
     ax = fig.axes[0]
-    assert ax.get_title() == "max |barge.force[1]| [N]" and ax.get_legend() is None
+    assert ax.get_title() == "max |barge.force[1]| [kN]" and ax.get_legend() is None   # the run plots' unit
     (legend,) = fig.legends
     assert legend.get_title().get_text() == "environment.current_speed [m/s]"
     # the radial values in the sector without data (0–180° used: at 270°), not over the lines
@@ -118,9 +117,9 @@ def test_batch_columns_are_the_knobs_as_written_and_poses_plot_without_their_off
     (fig,) = figs
     pose, load = fig.axes[:2]
     assert pose.get_title() == "max |buoy_dynamics.position[3] − initial| [m]"
-    assert load.get_title() == "max |buoy.force[3]| [N]"
+    assert load.get_title() == "max |buoy.force[3]| [kN]"
     assert sorted(max(line.get_ydata()) for line in pose.get_lines()) == [0.5, 1.0]   # not 6.5 and 7
-    assert sorted(max(line.get_ydata()) for line in load.get_lines()) == [2e3, 4e3]
+    assert sorted(max(line.get_ydata()) for line in load.get_lines()) == [2.0, 4.0]   # kN, as the run plots say
     assert fig._suptitle.get_text().startswith("buoy_in_waves: largest value per case against wave_direction")
     assert fig.legends[0].get_title().get_text().startswith("hs")
 

@@ -114,23 +114,17 @@ def test_time_axis_reads_minutes_and_hours_for_long_records():
     assert label == "time [h]" and t[-1] == pytest.approx(4.0)
 
 
-def test_a_panel_of_round_off_says_so_instead_of_magnifying_it():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from hydrofmu.cosim.report import _panel, round_off
+def test_negligible_dofs_and_small_loads_get_their_own_treatment():
+    from hydrofmu.cosim.report import by_scale, negligible
+    # a round body's yaw moment from BEM noise beside 300 kN·m of pitch: listed, not drawn
+    assert negligible(6e-4, 300.0) and not negligible(0.5, 300.0)
+    assert negligible(1e-10, 0.0) and not negligible(1e-3, 0.0)   # alone, a millimetre is no noise
+    # a 0.26 kN drift force beside ±100 kN of waves: on an axis of its own
     t = np.linspace(0.0, 100.0, 1001)
-    mz = [("waves", 2, 1e-13 * np.sin(t)), ("total", 2, 1.2e-13 * np.sin(t))]   # kN·m, beside a 3000 kN·m pitch moment
-    assert round_off(mz, 3000.0) == pytest.approx(1.2e-13, rel=1e-3)
-    assert round_off(mz, 1e-4) is None          # 1.2e-13 is more than 1e-9 of a 1e-4 scale: a load, not round-off
-    assert round_off([("waves", 2, np.zeros_like(t))], 3000.0) is None       # zero is said as zero
-    fig, (noise, real) = plt.subplots(1, 2)
-    _panel(noise, t, mz, "yaw moment Mz [kN·m]", {}, scale=3000.0, unit="kN·m")
-    assert [x.get_text() for x in noise.texts] == ["round-off only: |value| ≤ 1.2e-13 kN·m"]
-    assert noise.get_ylim() == (-1.0, 1.0)
-    _panel(real, t, [("waves", 2, 50 * np.sin(t))], "yaw moment Mz [kN·m]", {}, scale=3000.0, unit="kN·m")
-    assert not real.texts and real.get_ylim()[1] == pytest.approx(60.0, rel=0.01)   # ±50 widened by 10 % of 100
-    plt.close(fig)
+    waves, drift = 100 * np.sin(t), 0.26 + 0.05 * np.sin(0.1 * t)
+    curves = [("waves", "C0", waves, False), ("drift", "C1", drift, False), ("total", "k", waves + drift, True)]
+    large, small = by_scale(curves)
+    assert [c[0] for c in large] == ["waves", "total"] and [c[0] for c in small] == ["drift"]
 
 
 def _hydrofmu(*args, cwd):
@@ -146,7 +140,9 @@ def test_run_writes_csv_png_and_summary_next_to_the_build_and_says_where(tmp_pat
     csv, png, summary = out / "moored_barge.csv", out / "moored_barge.png", out / "moored_barge.summary.json"
     assert f"in {out / 'moored_barge'}" in done.stdout             # where it built
     parquet = out / "moored_barge.parquet"
-    assert f"wrote {csv}, {parquet}, {png} and {summary}" in done.stdout       # where it wrote
+    spectra, spectra_png = out / "moored_barge.spectra.csv", out / "moored_barge.spectra.png"
+    assert f"wrote {csv}, {parquet}, {png}, {summary}, {spectra} and {spectra_png}" in done.stdout   # where it wrote
+    assert "warning" not in done.stderr.lower(), done.stderr
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     result = read_csv(csv)
     assert len(result.time) == 11

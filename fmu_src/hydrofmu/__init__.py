@@ -5,6 +5,7 @@ Public API (imported on first use, so ``import hydrofmu`` stays cheap):
 - ``load_scene(path) -> Scene``: read and validate a scene file;
 - ``build(scene, out) -> Path``: build its FMUs into ``out/<scene name>/``;
 - ``run(scene_or_folder, stop=..., step=...) -> Result``: build if needed and run;
+  ``run_files(folder, engine)``: the files ``hydrofmu run`` writes beside a build;
 - ``tune(scene, tolerance) -> Tuning``: the cheapest run settings within a tolerance;
 - ``read_parquet(path)``: the Parquet file a streamed run wrote, columns read when asked;
 - ``Result`` (``to_csv``, ``plot``, ``motion``, ``vector``) and ``read_csv``;
@@ -28,7 +29,7 @@ __version__ = "0.1.0"
 # public name -> module (relative to the package) that defines it
 _WHERE = {
     "load_scene": "api", "Scene": "scene", "InputError": "errors",
-    "build": "api", "run": "api", "tune": "tuning", "Tuning": "tuning", "run_batch": "batch", "read_series": "batch",
+    "build": "api", "run": "api", "run_files": "api", "tune": "tuning", "Tuning": "tuning", "run_batch": "batch", "read_series": "batch",
     "Result": "cosim.result", "read_csv": "cosim.result", "read_parquet": "cosim.stream",
     "ViscousDrag": "physics.viscous_drag", "CurrentPolar": "physics.current_polar",
     "LumpedBody": "physics.lumped", "BallJoint": "physics.joint", "Coupling": "physics.coupling",

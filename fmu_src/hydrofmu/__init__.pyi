@@ -3,10 +3,10 @@ __version__: str
 __all__ = [
     'BallJoint', 'BodyLoads', 'Convolution', 'CoupledBodies', 'Coupling', 'CurrentPolar', 'Env',
     'InputError', 'LumpedBody', 'Motion', 'Result', 'RigidBody', 'Scene', 'StateSpace',
-    'Tuning', 'ViscousDrag', '__version__', 'build', 'load_scene', 'read_csv', 'read_parquet', 'run', 'tune',
+    'Tuning', 'ViscousDrag', '__version__', 'build', 'load_scene', 'read_csv', 'read_parquet', 'run', 'run_files', 'tune',
 ]
 
-from .api import build, load_scene, run
+from .api import build, load_scene, run, run_files
 from .cosim.result import Result, read_csv
 from .cosim.stream import read_parquet
 from .errors import InputError

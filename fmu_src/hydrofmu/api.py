@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 DEFAULT_OUT = Path("build") / "fmus"
 
-__all__ = ["load_scene", "build", "run", "outputs", "inputs_hash", "built_folder"]
+__all__ = ["load_scene", "build", "run", "outputs", "run_files", "inputs_hash", "built_folder"]
 PACKAGE = Path(__file__).resolve().parent
 
 
@@ -227,8 +227,22 @@ def run(source: str | Path | Scene, *, stop: float | None = None, step: float | 
                     outputs=outputs, interval=interval, sink=Sink(parquet, csv) if parquet or csv else None)
 
 
-def outputs(folder: str | Path) -> tuple[Path, Path]:
-    """Where ``hydrofmu run``/``demo`` write the CSV and PNG of a built scene folder:
-    next to it, ``<folder>.csv`` and ``<folder>.png``."""
+def outputs(folder: str | Path, engine: str | None = None) -> tuple[Path, Path]:
+    """Where ``hydrofmu run``/``demo`` write the CSV and PNG of a built scene folder: next to
+    it, ``<folder>.csv`` and ``<folder>.png`` (``<folder>.libcosim.csv``, … for the libcosim
+    engine: `run_files`)."""
+    files = run_files(folder, engine)
+    return files["csv"], files["png"]
+
+
+def run_files(folder: str | Path, engine: str | None = None) -> dict:
+    """Every file ``hydrofmu run`` writes by default for a built scene folder, next to it:
+    ``csv``, ``parquet``, ``png``, ``summary`` (``.summary.json``), ``spectra``
+    (``.spectra.csv``) and ``spectra_png`` (``.spectra.png``), named ``<folder>.<suffix>``
+    for hydrofmu's fmpy master and ``<folder>.libcosim.<suffix>`` for libcosim, so that the
+    two engines' runs of one build stand side by side."""
     folder = Path(folder)
-    return folder.with_name(folder.name + ".csv"), folder.with_name(folder.name + ".png")
+    stem = folder.name + ("" if engine in (None, "fmpy") else f".{engine}")
+    suffixes = {"csv": ".csv", "parquet": ".parquet", "png": ".png", "summary": ".summary.json",
+                "spectra": ".spectra.csv", "spectra_png": ".spectra.png"}
+    return {k: folder.with_name(stem + v) for k, v in suffixes.items()}

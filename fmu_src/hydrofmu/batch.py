@@ -57,8 +57,10 @@ EXPOSED = {"environment.current_speed": "current.speed", "environment.current_di
            **{f"waves.{k}": f"waves.{k}" for k in ("hs", "tp", "gamma", "direction", "spreading", "components",
                                                    "seed", "ramp", "height", "period", "phase")}}
 # statistics of each output; significant = 4·std (the significant value of a narrow-band
-# response, as Hs = 4·sqrt(m0) of the elevation)
-STATS = ("max", "min", "mean", "std", "significant", "final", "initial")
+# response, as Hs = 4·sqrt(m0) of the elevation); then the low- and wave-frequency parts and
+# the expected extremes of cosim.statistics (docs/running.md)
+ANALYST = ("lf_std", "wf_std", "wf_mpm", "lf_mpm", "mpm_max", "mpm_min")
+STATS = ("max", "min", "mean", "std", "significant", "final", "initial") + ANALYST
 FILE_KEYS = file_keys.names(file_keys.CASES)
 SCENE_SECTIONS = ("scene", "environment", "run", "bodies", "joints", "couplings", "waves")
 
@@ -68,7 +70,9 @@ class Batch:
     """A validated case file.  ``scene``: scene file or built scene folder; ``outputs``:
     'instance.variable' names; ``fixed``: knobs of every case; ``matrix``: key → values
     (cases are the cross product); ``extra``: single cases after the matrix ones;
-    ``transient`` [s]: statistics leave out t < transient; ``series``: write time series."""
+    ``transient`` [s]: statistics leave out t < transient; ``series``: write time series;
+    ``split`` [s]: the period between the statistics' LF and WF parts (default 2·Tp of each
+    case's sea)."""
     path: Path
     scene: Path
     outputs: list
@@ -78,6 +82,7 @@ class Batch:
     transient: float = 0.0
     series: bool = False
     names: dict = field(default_factory=dict)   # canonical key -> the key as the file wrote it (the table's column)
+    split: float = None   # period [s] between the LF and WF parts (None: 2·Tp of each case's sea)
 
     def __len__(self):
         n = math.prod(len(v) for v in self.matrix.values()) if self.matrix else (0 if self.extra else 1)
@@ -228,7 +233,9 @@ def load_cases(source, base=None) -> Batch:
         if value is not None and value not in ALGORITHMS:
             p.add(where, f"expected one of {', '.join(map(repr, ALGORITHMS))} (a batch runs on the fmpy master), "
                          f"found {value!r}")
-    batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True, _written(doc))
+    split = p.number(doc, "split", "split", positive=True) if "split" in doc else None
+    batch = Batch(path, scene, outputs, fixed, matrix, extra, transient or 0.0, series is True, _written(doc),
+                  split)
     built = scene is not None and scene.is_dir()
     for key in batch.keys:
         first = key.split(".", 1)[0].split("[", 1)[0]
@@ -550,16 +557,23 @@ def _materialize(blob):
     return folder
 
 
-def statistics(time_, values, outputs, transient=0.0):
-    """{'<output>.max|min|mean|std|significant|final': value} over the samples with t ≥ transient
-    (mean and std: plain sample statistics, the steps being equal); ``initial``: the value at the
-    start of the run (a body's position: its static pose, which the plot leaves out)."""
-    keep = values[time_ >= transient - 1e-9 * max(1.0, abs(transient))]
+def statistics(time_, values, outputs, transient=0.0, split=None):
+    """{'<output>.<stat>': value} of ``STATS`` over the samples with t ≥ transient: max, min, mean,
+    std (plain sample statistics, the steps being equal), significant = 4·std, final; ``initial``:
+    the value at the start of the run (a body's position: its static pose, which the plot leaves
+    out); and the figures ``ANALYST`` of ``cosim.statistics.describe``, split at ``split`` [s]
+    (None: the LF and WF figures are NaN)."""
+    from .cosim.statistics import describe
+    at = time_ >= transient - 1e-9 * max(1.0, abs(transient))
+    keep = values[at]
+    t = time_[at]
+    dt = float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else 1.0
     out = {}
     for j, name in enumerate(outputs):
         col = keep[:, j]
+        more = describe(col, dt, split)
         for stat, value in zip(STATS, (col.max(), col.min(), col.mean(), col.std(), 4 * col.std(), col[-1],
-                                       values[0, j])):
+                                       values[0, j]) + tuple(more[k] for k in ANALYST)):
             out[f"{name}.{stat}"] = float(value)
     return out
 
@@ -589,12 +603,17 @@ def run_case(task, blob):
         out = {"case": task["case"], "status": "ok", "error": None, "wall_s": None, "stats": {}, "series": None,
                "linear_range": None, "max_tilt_deg": None}
         tilt = []
+        said = out["warnings"] = []   # the FMUs' warnings: the client says them with the case's name
         try:
             folder = _materialize(blob)
             tilt = _tilt_columns(folder)
             record = list(task["outputs"]) + [c for c in tilt if c not in task["outputs"]]
             t0 = time.perf_counter()
-            result = run(folder, record=record, parameters=task["parameters"], progress=False, **task["run"])
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                result = run(folder, record=record, parameters=task["parameters"], progress=False, say=said.append,
+                             **task["run"])
+            said += [f"{w.category.__name__}: {w.message}" for w in caught]
         except Exception as exc:   # a failing case is reported, the batch goes on
             text = str(exc)
             # capsized (the dynamics partner's word): said first, not as an exception's class
@@ -615,7 +634,7 @@ def run_case(task, blob):
             k, j = np.argwhere(bad)[0]
             out.update(status="failed", error=f"diverged: {task['outputs'][j]} = {values[k, j]} at t = "
                                               f"{result.time[k]:g} s")
-        out["stats"] = statistics(result.time, values, task["outputs"], task["transient"])
+        out["stats"] = statistics(result.time, values, task["outputs"], task["transient"], task.get("split"))
         if task["series"]:
             out["series"] = (result.time, values)
         try:
@@ -702,11 +721,29 @@ def _open_client(client, scheduler, workers):
     return c, [c, cluster]
 
 
+def _sea_split(variant, exposed, seas):
+    """A case's default split period [s]: 2·Tp of its sea (the build's, or the case's own
+    ``waves.tp`` / ``waves.period``); None without a sea.  ``seas`` caches each build's sea."""
+    from .cosim.statistics import SPLIT_TP
+    if variant.folder is None:
+        return None
+    if variant.folder not in seas:
+        try:
+            seas[variant.folder] = read_manifest(variant.folder)["run"].get("waves")
+        except (OSError, KeyError, ValueError, InputError):
+            seas[variant.folder] = None
+    sea = seas[variant.folder]
+    if not sea:
+        return None
+    period = exposed.get("waves.period" if sea.get("spectrum") == "regular" else "waves.tp", sea.get("period"))
+    return SPLIT_TP * period if isinstance(period, (int, float)) and period > 0 else None
+
+
 def _plan(batch, variants, log):
     """(case id, knobs, variant, task, error) of every case, lazily.  Names every case
     shares (outputs, FMU variables) are checked on the first case: a wrong one is an
     InputError; a bad value is the error of its case only."""
-    first, unused = True, set()
+    first, unused, seas = True, set(), {}
     for knobs in batch.cases():
         exposed = {k: v for k, v in knobs.items() if k in EXPOSED}
         direct = {k: v for k, v in knobs.items()
@@ -733,10 +770,11 @@ def _plan(batch, variants, log):
                 parameters.update(dict.fromkeys(names, value))
             parameters.update(direct)
             first = False
+        split = batch.split or _sea_split(variant, exposed, seas)
         cid = _digest([sorted(knobs.items()), variant.id, variant.error, variant.run, parameters,
-                       batch.outputs, batch.transient])
+                       batch.outputs, batch.transient, split])
         task = {"case": cid, "run": variant.run, "parameters": parameters, "outputs": batch.outputs,
-                "transient": batch.transient, "series": batch.series}
+                "transient": batch.transient, "series": batch.series, "split": split}
         yield cid, knobs, variant, task, "; ".join(errors) or None
 
 
@@ -782,10 +820,14 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
     kept = {}   # case rows that could not be written to cases/ (disk full, folder gone): the table has them
 
     def record(cid, knobs, variant, result):
+        said = result.get("warnings") or []
+        name = case_name(batch, cid, knobs)
+        for text in said:   # a worker's warning, named by its case
+            log(f"warning: {name}: {text}")
         row = {"case": cid, "knobs": knobs, "status": result["status"], "error": result["error"],
                "wall_s": result["wall_s"], "stats": result["stats"], "build": variant.id, "batch": token,
                "linear_range": result.get("linear_range"), "max_tilt_deg": result.get("max_tilt_deg"),
-               "worker": result.get("worker")}
+               "worker": result.get("worker"), "warnings": said}
         try:
             (out / "cases").mkdir(parents=True, exist_ok=True)   # here: a batch refused at its first case writes none
             if result.get("series") is not None:
@@ -840,6 +882,12 @@ def _run_batch(batch, out, workers, scheduler, client, retry_failed, progress, l
     return assemble_table(out, ids, batch, _output_units(variants, batch.outputs), kept, log)
 
 
+def case_name(batch, cid, knobs):
+    """'case 1a2b3c4d (hs = 3, wave_direction = 45)': a case as its warnings name it (the
+    first 8 characters of its id, its knobs as the case file wrote them)."""
+    return f"case {cid[:8]} (" + ", ".join(f"{batch.column(k)} = {_cell(v)}" for k, v in knobs.items()) + ")"
+
+
 def _output_units(variants, outputs):
     """Output -> unit, from the FMUs of the first build that succeeded ({} if none did)."""
     from .cosim.result import column_units
@@ -889,10 +937,11 @@ def assemble_table(out, ids, batch, units=None, kept=None, log=print):
         r = (kept or {}).get(cid) or json.loads((Path(out) / "cases" / f"{cid}.json").read_text())
         rows.append({**{batch.column(k): _cell(v) for k, v in r["knobs"].items()}, "status": r["status"],
                      "wall_s": r["wall_s"], "linear_range": r.get("linear_range"), "max_tilt_deg": r.get("max_tilt_deg"),
-                     **r["stats"], "error": r["error"], "case": r["case"], "build": r["build"]})
+                     **r["stats"], "error": r["error"], "warnings": "; ".join(r.get("warnings") or []),
+                     "case": r["case"], "build": r["build"]})
     stats = [f"{o}.{s}" for o in batch.outputs for s in STATS]
     columns = ([batch.column(k) for k in batch.keys] + ["status", "wall_s", "linear_range", "max_tilt_deg"] + stats
-               + ["error", "case", "build"])
+               + ["error", "warnings", "case", "build"])
     table = pd.DataFrame(rows, columns=columns)
     written = {}
     for name, write in (("cases.csv", lambda p: table.to_csv(p, index=False)),
@@ -938,13 +987,19 @@ def _is_pose(output):
                                           for w in ("position", "attitude"))
 
 
+# the run plots' units (cosim.report): the table holds SI, its plot what a run's plot shows
+DISPLAY = {"rad": ("deg", 180 / math.pi), "rad/s": ("deg/s", 180 / math.pi), "rad/s2": ("deg/s2", 180 / math.pi),
+           "N": ("kN", 1e-3), "N.m": ("kN·m", 1e-3)}
+
+
 def plot(table, batch, path, units=None):
     """Largest |output| per case: a polar plot against the first direction knob (one line per
     combination of the other knobs, one legend for the figure below the panels), else against
-    the first numeric knob; ``units``: output -> unit, in each panel's title.  A body's position
+    the first numeric knob; ``units``: output -> unit (SI, as the FMUs declare it), shown as the
+    run's plots show it (``DISPLAY``: deg, kN, kN·m) in each panel's title.  A body's position
     and attitude are taken from their initial value (the static pose: a reference point 6 m
-    below the waterline is no 6 m response).  Knobs are named as the case file wrote them.  None
-    if there is nothing to plot."""
+    below the waterline is no 6 m response).  Knobs are named as the case file wrote them;
+    at most three panels to a row.  None if there is nothing to plot."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -961,12 +1016,16 @@ def plot(table, batch, path, units=None):
     others = [batch.column(k) for k in other_keys]
     units = units or {}
     n = len(batch.outputs)
-    fig, axes = plt.subplots(1, n, figsize=(5 * n, 5.4), squeeze=False,
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    legend_room = 1.1 if others else 0.0
+    fig, axes = plt.subplots(rows, cols, figsize=(5.6 * cols, 5.2 * rows + legend_room + 0.6), squeeze=False,
                              subplot_kw={"projection": "polar"} if polar else {})
-    for ax, name in zip(axes[0], batch.outputs):
+    for ax, name in zip(axes.flat, batch.outputs):
         pose = _is_pose(name) and f"{name}.initial" in ok
         start = ok[f"{name}.initial"].fillna(0.0) if pose else 0.0
-        peak = np.maximum((ok[f"{name}.max"] - start).abs(), (ok[f"{name}.min"] - start).abs())
+        unit, factor = DISPLAY.get(units.get(name), (units.get(name), 1.0))
+        peak = np.maximum((ok[f"{name}.max"] - start).abs(), (ok[f"{name}.min"] - start).abs()) * factor
         groups = ok.groupby(others, sort=True) if others else [((), ok)]
         for label, g in groups:
             g = g.sort_values(axis)
@@ -974,22 +1033,24 @@ def plot(table, batch, path, units=None):
             y = peak[g.index].to_numpy()
             label = ", ".join(f"{v}" for v in (label if isinstance(label, tuple) else (label,)))
             ax.plot(x, y, "o-", label=label or None)
-        unit = units.get(name)
         what = f"max |{name} − initial|" if pose else f"max |{name}|"
-        ax.set_title(what + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=9, pad=14)
-        ax.tick_params(labelsize=8)
+        ax.set_title(what + (f" [{unit}]" if unit else " [unit unknown]"), fontsize=11, pad=16)
+        ax.tick_params(labelsize=10)
         if polar:   # radial values in the middle of the widest sector without data: they cover no line
             ax.set_rlabel_position(_emptiest(ok[axis].to_numpy(float)))
         else:
-            ax.set_xlabel(_with_unit(key, axis))
+            ax.set_xlabel(_with_unit(key, axis), fontsize=10)
             ax.grid(True, alpha=0.3)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    height = fig.get_figheight()
     if others:   # one legend for the figure, below the panels: it covers no label
         handles, labels = axes[0][0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
-                   title=", ".join(_with_unit(k, c) for k, c in zip(other_keys, others)), title_fontsize=8)
+        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=10, frameon=False,
+                   title=", ".join(_with_unit(k, c) for k, c in zip(other_keys, others)), title_fontsize=10)
     fig.suptitle(f"{batch.scene.stem}: largest value per case against {axis}"
-                 + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=10, y=0.98)
-    fig.tight_layout(rect=(0, 0.1 if others else 0, 1, 0.92))
+                 + (" (degrees, counter-clockwise from +x)" if polar else ""), fontsize=12, y=1 - 0.15 / height)
+    fig.tight_layout(rect=(0, (legend_room + 0.1) / height if others else 0, 1, 1 - 0.55 / height))
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

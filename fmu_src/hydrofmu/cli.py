@@ -8,7 +8,7 @@ import warnings
 import zipfile
 from pathlib import Path
 
-from .api import DEFAULT_OUT, built_folder, inputs_hash, outputs
+from .api import DEFAULT_OUT, built_folder, inputs_hash, run_files
 from .scene.files import scene_files
 from .cosim.manifest import read_manifest
 from .cosim.master import check_steps, describe
@@ -87,14 +87,16 @@ def _stderr(text):
 
 
 def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=0.0, log=_stderr, say=print,
-               parquet=None, inputs=(), **kw):
+               parquet=None, inputs=(), split=None, spectra=None, spectra_png=None, **kw):
     """Run a built scene folder with fmpy (our master) or libcosim (default: libcosim for
-    an ECCO run, else fmpy), its settings said once first (``say``); write CSV/PNG and the
-    summary's JSON (checked writable first).  The Result's ``stats`` is its summary over
-    t ≥ ``transient``.  fmpy runs stream their rows into the CSV and ``parquet`` (default:
-    beside the CSV when pyarrow is installed) as they go, and the PNG and the summary are
-    read from the file; a libcosim run writes the same files after it ends.  A write that fails after
-    the run goes to a fallback folder: ``written`` maps each asked path to the one written."""
+    an ECCO run, else fmpy), its settings said once first (``say``); write CSV/PNG, the
+    summary's JSON and the response spectra (``spectra`` CSV, ``spectra_png``), each checked
+    writable first.  The Result's ``stats`` is its summary over t ≥ ``transient``, split at
+    ``split`` [s] (default: the scene's).  fmpy runs stream their rows into the CSV and
+    ``parquet`` (default: beside the CSV when pyarrow is installed) as they go, and the PNG
+    and the summary are read from the file, whole; a libcosim run writes the same files after
+    it ends.  A write that fails after the run goes to a fallback folder: ``written`` maps
+    each asked path to the one written."""
     from .cosim.libcosim import engine_for
     from .cosim.master import run_settings
     folder = Path(folder)
@@ -102,15 +104,19 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
               inputs=inputs)
     if not (math.isfinite(transient) and transient >= 0):
         raise InputError("command line", None, "--transient", f"must be a finite time ≥ 0 [s], found {transient:g}")
+    if split is not None and not (math.isfinite(split) and split > 0):
+        raise InputError("command line", None, "--split", f"must be a period > 0 [s], found {split:g}")
     manifest = read_manifest(folder)
     if transient and transient >= (kw.get("stop") or manifest["run"]["stop"]):
         raise InputError("command line", None, "--transient",
                          f"{transient:g} s leaves nothing of a run that ends at {kw.get('stop') or manifest['run']['stop']:g} s")
     if parquet is None and csv is not None and _has_pyarrow():
         parquet = Path(csv).with_suffix(".parquet")
+    files = (csv, summary, parquet, spectra)
+    after = dict(summary=summary, transient=transient, split=split, spectra=spectra, spectra_png=spectra_png, log=log)
     if engine_for(folder, kw.get("algorithm"), engine) == "libcosim":
         from .cosim.libcosim import run
-        check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))
+        check_outputs(files=files, plots=(png, spectra_png), inputs=(*inputs, folder))
         say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
         try:
             result = run(folder, **kw)
@@ -122,10 +128,10 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         if parquet:   # the files an fmpy run writes, written when the run ends
             from .cosim.stream import write_parquet
             result.written[Path(parquet)] = write_parquet(result, parquet, log)
-        return _plot_and_summary(result, png, summary, transient, log)
+        return _plot_and_summary(result, png, **after)
     from .cosim.master import run
     from .cosim.stream import Sink
-    check_outputs(files=(csv, summary, parquet), plots=(png,), inputs=(*inputs, folder))   # the parquet too
+    check_outputs(files=files, plots=(png, spectra_png), inputs=(*inputs, folder))   # the parquet too
     say(f"{folder.name}: {describe(run_settings(manifest, kw.get('step'), kw.get('algorithm'), kw.get('stop')))}")
     from .cosim.master import RunError
     try:
@@ -136,7 +142,7 @@ def run_folder(folder, engine=None, csv=None, png=None, summary=None, transient=
         _plot_partial(exc, manifest, png, log)
         raise
     result.written = {Path(asked): Path(got) for asked, got in getattr(result, "written", {}).items()}
-    return _plot_and_summary(result, png, summary, transient, log)
+    return _plot_and_summary(result, png, **after)
 
 
 def _plot_partial(exc, manifest, png, log):
@@ -163,17 +169,26 @@ def _as_option(exc):
     return exc
 
 
-def _plot_and_summary(result, png, summary, transient, log):
-    """The PNG and the summary of a run (each engine's), when it recorded what they need."""
+def _plot_and_summary(result, png, summary, transient, log, split=None, spectra=None, spectra_png=None):
+    """The summary (over the whole record), the PNG and the response spectra of a run (each
+    engine's), when it recorded what they need."""
     missing = _unplotted(result)
     if png and missing:
         log(f"warning: no PNG: the plot needs every output of the bodies' FMUs, and {missing} was not "
             "recorded (--outputs / [run] outputs)")
-    elif png:
-        result.written[Path(png)] = keep(result.plot, png, log)[0]
-    result.stats = result.summary(transient) if not missing else None
+    result.stats = result.summary(transient, split) if not missing else None
+    if png and not missing:
+        result.written[Path(png)] = keep(lambda p: result.plot(p, split=split), png, log)[0]
     if summary and result.stats is not None:
         result.written[Path(summary)] = keep(result.stats.to_json, summary, log)[0]
+    if result.stats is not None and result.stats.spectra:
+        from .cosim.report import plot_spectra
+        if spectra:
+            result.written[Path(spectra)] = keep(result.stats.write_spectra, spectra, log)[0]
+        if spectra_png:
+            drawn = keep(lambda p: plot_spectra(result.stats, result.manifest, p), spectra_png, log)[0]
+            if drawn.exists():
+                result.written[Path(spectra_png)] = drawn
     return result
 
 
@@ -368,10 +383,14 @@ def make_parser():
                        description="Run a scene and write its results: the CSV (header 'instance.variable "
                                    "[unit]', one row per output point) and Parquet files, written as the run goes "
                                    "(bounded memory), and the PNG (motion from the initial pose, every load, joint "
-                                   "gaps) drawn from the file, next to the built folder: <folder>.csv, "
-                                   "<folder>.parquet, <folder>.png, unless --csv/--parquet/--png say otherwise, and "
-                                   "the summary (mean, std, min, max of each body's motion and loads per dof, with "
-                                   "units): printed and written as <folder>.summary.json.  A scene file whose build "
+                                   "gaps; a long record as its whole-run envelope beside its last peak periods) "
+                                   "drawn from the whole file, next to the built folder: <folder>.csv, "
+                                   "<folder>.parquet, <folder>.png, unless --csv/--parquet/--png say otherwise; the "
+                                   "summary (mean, std, min, max of each body's motion and loads per dof, their "
+                                   "low- and wave-frequency parts and expected extremes, with units): printed and "
+                                   "written as <folder>.summary.json; the response spectra as <folder>.spectra.csv "
+                                   "and .spectra.png.  The libcosim engine's files are <folder>.libcosim.csv, … "
+                                   "(both engines' runs of a build stand side by side).  A scene file whose build "
                                    "in OUT is up to date is not built again.  Step, stop and algorithm "
                                    "default to the scene's [run] settings (its preset's).")
     r.add_argument("scene", metavar="SCENE", help="scene file (.toml, built into OUT first) or built scene folder")
@@ -385,10 +404,15 @@ def make_parser():
     r.add_argument("--step", type=float, metavar="S",
                    help="communication step [s], ECCO's first step (default: the scene's)")
     r.add_argument("--stop", type=float, metavar="T", help="end time [s] (default: the scene's)")
-    r.add_argument("--csv", type=Path, metavar="FILE", help="CSV file to write (default: <folder>.csv)")
-    r.add_argument("--png", type=Path, metavar="FILE", help="PNG file to write (default: <folder>.png)")
+    r.add_argument("--csv", type=Path, metavar="FILE",
+                   help="CSV file to write (default: <folder>.csv; libcosim: <folder>.libcosim.csv)")
+    r.add_argument("--png", type=Path, metavar="FILE",
+                   help="PNG file to write (default: <folder>.png; libcosim: <folder>.libcosim.png)")
     r.add_argument("--transient", type=float, default=0.0, metavar="T",
                    help="the summary's statistics leave out t < T [s]")
+    r.add_argument("--split", type=float, metavar="T",
+                   help="period [s] between the statistics' low- and wave-frequency parts (default: the scene's "
+                        "[run] split, else 2·Tp of its sea)")
     r.add_argument("--parquet", type=Path, metavar="FILE",
                    help="Parquet file to write (default: <folder>.parquet, when pyarrow is installed)")
     r.add_argument("--outputs", nargs="+", metavar="NAME",
@@ -557,11 +581,13 @@ def _main(argv):
                       {**scene.run, "source": str(scene.path)}, args.algorithm, args.out,
                       inputs=inputs)
             folder = next(iter(build([scene], args.out).values()))
-        csv, png = outputs(folder)
-        csv, png = args.csv or csv, args.png or png
+        from .cosim.libcosim import engine_for
+        files = run_files(folder, engine_for(folder, args.algorithm, args.engine))   # each engine its own files
+        csv, png = args.csv or files["csv"], args.png or files["png"]
         extra = {k: v for k, v in (("outputs", args.outputs), ("interval", args.interval)) if v is not None}
-        result = run_folder(folder, args.engine, csv, png, folder.with_name(folder.name + ".summary.json"),
-                            args.transient, parquet=args.parquet, inputs=inputs, stop=args.stop, step=args.step,
+        result = run_folder(folder, args.engine, csv, png, files["summary"], args.transient, parquet=args.parquet,
+                            inputs=inputs, split=args.split, spectra=files["spectra"],
+                            spectra_png=files["spectra_png"], stop=args.stop, step=args.step,
                             algorithm=args.algorithm, **extra)
         if result.stats is not None:
             print(result.stats)
@@ -583,12 +609,13 @@ def _main(argv):
         folders = build(scenes, args.out)
         code = 0
         for name in args.scene or folders:
-            csv, png = outputs(folders[name])
-            result = run_folder(folders[name], "fmpy", csv, png, folders[name].with_name(name + ".summary.json"))
+            files = run_files(folders[name])
+            result = run_folder(folders[name], "fmpy", files["csv"], files["png"], files["summary"],
+                                spectra=files["spectra"], spectra_png=files["spectra_png"])
             wrote, failed = _wrote(result)
             code = max(code, failed)
-            print(f"ran {name}: {_steps(result)}; {wrote} (the summary: mean, std, min, max "
-                  f"per body and dof)")
+            print(f"ran {name}: {_steps(result)}; {wrote} (the summary: mean, std, min, max, the LF and WF parts "
+                  f"and the expected extremes per body and dof)")
         return code
     elif args.command == "bem2simo":
         made = bem2simo(args.result, args.out, args.ulen, args.rho, args.dofs, args.timdel, args.kernel_length,

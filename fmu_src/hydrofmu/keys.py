@@ -81,6 +81,7 @@ RUN = {
     "outputs": ({**NAMES, "minItems": 1}, "what hydrofmu run records: body names, body.position (attitude, velocity, "
                                           "acceleration), instance.variable (default: every output)"),
     "interval": (POSITIVE, "output interval [s], a whole number of steps (default: every step)"),
+    "split": (POSITIVE, "period [s] splitting the statistics' low- and wave-frequency parts (default: 2·Tp of the sea)"),
 }
 
 LUMPED = {
@@ -273,6 +274,7 @@ CASES = {
     "step": (POSITIVE, "communication step of every case [s]"),
     "algorithm": (enum("jacobi", "gauss-seidel", "ecco"), "master algorithm of every case"),
     "transient": (NONNEG, "statistics leave out t < transient [s]"),
+    "split": (POSITIVE, "period [s] splitting the low- and wave-frequency parts (default: 2·Tp of each case's sea)"),
     "series": ({"type": "boolean"}, "write each case's time series"),
     "set": ({"type": "object"}, "knobs of every case: {\"key.path\" = value}"),
     "matrix": ({"type": "object", "additionalProperties": {"type": "array", "minItems": 1}},

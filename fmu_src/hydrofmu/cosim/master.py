@@ -95,9 +95,10 @@ def _model_description(folder):
 class Instance:
     """One FMU instance with its value references by name."""
 
-    def __init__(self, name, fmu_path):
+    def __init__(self, name, fmu_path, say=None):
         self.name = name
         self.errors = []   # error/fatal messages the FMU logged (they go into RunError)
+        self.say = say     # where its other log lines go (default: stderr)
         self.dir = str(unpacked(fmu_path))   # unzipped once, shared with later runs (cosim.unpacked)
         self.md = _model_description(self.dir)
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
@@ -134,7 +135,10 @@ class Instance:
             self.errors.append(text)
             return
         label = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")[status] if 0 <= status < 6 else status
-        sys.stderr.write(f"[{label}] {text}\n")
+        if self.say is not None:
+            self.say(f"[{label}] {text}")
+        else:
+            sys.stderr.write(f"[{label}] {text}\n")
 
     def outputs(self):
         return [n for n, c in self.causality.items() if c == "output"]
@@ -309,14 +313,15 @@ class System:
         self.instances = {}
 
 
-def load(folder, parameters=None):
-    """The System of a built scene's folder (its manifest.json and FMUs), loaded with fmpy."""
+def load(folder, parameters=None, say=None):
+    """The System of a built scene's folder (its manifest.json and FMUs), loaded with fmpy;
+    ``say``: where the FMUs' warnings go (a callable taking a line; default stderr)."""
     folder = Path(folder)
     manifest = read_manifest(folder)
     instances = {}
     try:
         for name in manifest["order"]:
-            instances[name] = Instance(name, folder / manifest["instances"][name]["fmu"])
+            instances[name] = Instance(name, folder / manifest["instances"][name]["fmu"], say)
     except Exception:
         for inst in instances.values():
             inst.free()
@@ -368,7 +373,7 @@ def _check_parameters(parameters, manifest):
 
 
 def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=None, progress=None,
-        on_step=None, outputs=None, interval=None, sink=None):
+        on_step=None, outputs=None, interval=None, sink=None, say=None):
     """Run a built scene (its folder), or a loaded ``System`` (initialised here, left loaded
     for the caller to free; ``parameters`` are then the System's own); returns a Result.
 
@@ -382,13 +387,14 @@ def run(folder, stop=None, step=None, algorithm=None, record=None, parameters=No
     ``parameters``: {'instance.variable': value} set in initialization mode.
     ``progress``: print a progress line to stderr (default: when more than 2000 steps).
     ``on_step``: called with the step count after each communication step (benchmarks).
+    ``say``: receives each warning line the FMUs log (default: stderr; a batch names its case).
     """
     own = not isinstance(folder, System)
     if own:   # refuse ECCO, and parameters on connected inputs or not numbers, before loading anything
         manifest = read_manifest(folder)
         _check_algorithm(algorithm or manifest["run"]["algorithm"], folder)
         _check_parameters(parameters or {}, manifest)
-    system = load(folder, parameters) if own else folder
+    system = load(folder, parameters, say) if own else folder
     t, rows, settings = 0.0, None, None
     try:
         cfg = system.manifest["run"]

@@ -143,12 +143,34 @@ class Result:
         """The unit of a column (``''`` when the FMU declares none)."""
         return "s" if column == "time" else self.units.get(column, "")
 
-    def summary(self, transient: float = 0.0):
-        """Per body and dof: mean, std, min, max of its motion (position [m], attitude
-        [rad]) and of each load on it and their total [N, N.m], over t ≥ ``transient`` [s].
-        Returns a `cosim.summary.Summary` (``print`` it, ``to_json``, ``to_pandas``)."""
+    def summary(self, transient: float = 0.0, split: float | None = None):
+        """Per body and dof, over t ≥ ``transient`` [s]: mean, std, min, max of its motion
+        (position [m], attitude [rad]) and of each load on it and their total [N, N.m], the
+        low- and wave-frequency parts split at ``split`` [s] (default: the scene's ``[run]
+        split``, else 2·Tp of its sea) with their std and the expected extremes, and the
+        response spectra.  Returns a `cosim.summary.Summary` (``print`` it, ``to_json``,
+        ``to_pandas``, ``write_spectra``)."""
         from .summary import summarize
-        return summarize(self, transient)
+        return summarize(self, transient, split)
+
+    def statistics(self, columns=None, transient: float = 0.0, split: float | None = None) -> dict:
+        """The figures of ``cosim.statistics.describe`` (mean, std, min, max, LF and WF std,
+        WF zero up-crossing period, expected extremes) of recorded columns ({column: {figure:
+        value}}, each with its ``unit``), over t ≥ ``transient`` [s], split at ``split`` [s]
+        (default as ``summary``); ``columns``: a name or a list (default: every column)."""
+        from . import statistics
+        from .summary import split_period
+        names = [columns] if isinstance(columns, str) else list(self.columns if columns is None else columns)
+        time = self.time
+        keep = time >= time[0] + transient
+        if len(time) and not keep.any():
+            raise ValueError(f"transient {transient:g} s leaves no point: the run ends at {time[-1]:g} s")
+        period = split_period(self.layout()[0], split)["period"]
+        out = {}
+        for name in names:
+            dt, x = statistics.uniform(time[keep], self[name][keep])
+            out[name] = {"unit": self.unit(name), **statistics.describe(x, dt, period)}
+        return out
 
     def to_pandas(self):
         """A pandas DataFrame: time [s] as the index, one column per recorded variable;
@@ -187,8 +209,9 @@ class Result:
             tmp.unlink(missing_ok=True)
         return path
 
-    def plot(self, path) -> Path:
-        """Write the PNG of ``cosim.report.plot`` (needs ``manifest``); returns the path."""
+    def plot(self, path, split: float | None = None) -> Path:
+        """Write the PNG of ``cosim.report.plot`` (needs ``manifest``), the low-frequency parts
+        split at ``split`` [s] (default as ``summary``); returns the path."""
         from .report import plot
         if self.manifest is None:
             raise ValueError("this Result has no manifest, which the plot needs (which FMU is which body's "
@@ -197,7 +220,7 @@ class Result:
         path = check_plot(path)
         if not path.parent.is_dir():
             raise InputError(path, None, "output file", f"folder {path.parent} does not exist")
-        plot(self, self.manifest, path)
+        plot(self, self.manifest, path, split)
         return path
 
 
@@ -257,8 +280,9 @@ def read_csv(path, manifest=None) -> Result:
     if not header or header[0][0] != "time":
         raise InputError(path, 1, "header", "expected a header row starting with 'time [s]' (a CSV of Result.to_csv)")
     data = np.array(data, dtype=float).reshape(-1, len(header))
-    if manifest is None and (path.with_suffix("") / "manifest.json").is_file():
-        manifest = path.with_suffix("")
+    if manifest is None:   # <folder>.csv, or <folder>.libcosim.csv (the libcosim engine's)
+        stem = path.with_suffix("")
+        manifest = next((f for f in (stem, stem.with_suffix("")) if (f / "manifest.json").is_file()), None)
     if isinstance(manifest, (str, Path)):
         m = Path(manifest)
         manifest = json.loads((m / "manifest.json" if m.is_dir() else m).read_text())

@@ -11,7 +11,8 @@
   under the asked name is always complete.
 - ``read_parquet``: a written file back as a ``FileResult``: the columns read from the file
   when asked (``result['barge.force[1]']``), never all at once unless ``values`` is asked;
-  ``thinned`` gives an in-memory Result of every k-th row (the plot of a long run).
+  its summary and plot read each column whole (every figure is the whole record's);
+  ``thinned`` gives an in-memory Result of every k-th row.
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from ..errors import InputError
 from .result import Result
 
 BLOCK = 4096       # rows buffered between writes (84 columns: 2.8 MB)
-PLOT_ROWS = 4000    # rows a plot of a streamed run draws at most (every k-th row; ~10 per pixel of a panel)
+PLOT_ROWS = 4000    # a streamed run longer than this is plotted by a process of its own
 
 
 def output_every(interval, step, where="run", field="interval"):
@@ -220,59 +221,28 @@ class FileResult(Result):
                       (self.settings or {}).get("step", self.step), self.dynamics, self.settings, self.units,
                       self.manifest)
 
-    def summary(self, transient: float = 0.0):
-        """``Result.summary`` read block by block: each block's statistics (``summary.summarize``)
-        combined exactly (counts, means, and squared deviations by Chan's pairwise rule;
-        min and max), so the whole run is never in memory."""
-        from .summary import Summary, summarize
-        start = self.time[0] + transient if len(self) else 0.0
-        if len(self) and self.time[-1] < start:
-            raise ValueError(f"transient {transient:g} s leaves no point: the run ends at {self.time[-1]:g} s")
-        acc, first, last, points, notes = {}, None, None, 0, []
-        for block in self.blocks():
-            keep = block.time >= start
-            if not keep.any():
-                continue
-            part = summarize(Result(block.time[keep], block.columns, block.values[keep], block.algorithm,
-                                    block.step, block.dynamics, block.settings, block.units, block.manifest))
-            n = part.points
-            first = part.start if first is None else first
-            last, points, notes = part.stop, points + n, part.notes
-            for r in part.rows:
-                key = (r["body"], r["quantity"], r["dof"])
-                m2 = r["std"] ** 2 * n
-                if key not in acc:
-                    acc[key] = {**r, "n": n, "m2": m2}
-                    continue
-                a = acc[key]
-                total, delta = a["n"] + n, r["mean"] - a["mean"]
-                a["mean"] += delta * n / total
-                a["m2"] += m2 + delta ** 2 * a["n"] * n / total
-                a["n"], a["min"], a["max"] = total, min(a["min"], r["min"]), max(a["max"], r["max"])
-        rows = []
-        for a in acc.values():
-            a["std"] = float(np.sqrt(a.pop("m2") / a.pop("n")))
-            rows.append(a)
-        return Summary((self.manifest or {}).get("scene", ""), first or 0.0, last or 0.0, points, rows, notes,
-                       (self.manifest or {}).get("flavour"))
-
-    def plot(self, path) -> Path:
-        """The PNG of ``cosim.report.plot`` drawn from every k-th row (at most ``PLOT_ROWS``).
-        A file longer than that is drawn by a fresh Python process reading it: the run's
-        process (its FMUs loaded) then never also holds matplotlib and the plotted rows, so
-        neither process's peak memory grows with the run."""
+    def plot(self, path, split: float | None = None) -> Path:
+        """The PNG of ``cosim.report.plot``.  A file longer than ``PLOT_ROWS`` is drawn by a
+        fresh Python process that reads it column by column, whole (the envelopes and the
+        low-frequency parts count every row): the run's process (its FMUs loaded) then never
+        also holds matplotlib and the plotted columns."""
         if len(self) <= PLOT_ROWS:
-            return self.thinned().plot(path)
+            return self.thinned().plot(path, split)
         import subprocess
         import sys
         package = __name__.rsplit(".", 2)[0]
         done = subprocess.run([sys.executable, "-c", f"import sys; from {package}.cosim.stream import read_parquet; "
-                                                     "read_parquet(sys.argv[1]).thinned().plot(sys.argv[2])",
-                               str(self.path), str(path)], capture_output=True, text=True)
+                                                     "s = None if sys.argv[3] == 'None' else float(sys.argv[3]); "
+                                                     "read_parquet(sys.argv[1]).plot_here(sys.argv[2], s)",
+                               str(self.path), str(path), repr(split)], capture_output=True, text=True)
         if done.returncode:
             last = (done.stderr.strip().splitlines() or ["no message"])[-1]
             raise RuntimeError(f"plotting {self.path} failed: {last}")
         return Path(path)
+
+    def plot_here(self, path, split=None) -> Path:
+        """``cosim.report.plot`` of the whole file in this process."""
+        return Result.plot(self, path, split)
 
     def __repr__(self):
         return f"FileResult({self.path}, {len(self)} rows, {len(self.columns)} columns)"

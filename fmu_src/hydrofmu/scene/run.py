@@ -32,8 +32,9 @@ PRESETS = {
 
 # what a run writes (not run knobs: no preset sets them): `outputs`, names of what to record
 # (body names, body.position …, instance.variable; default every output), `interval`, the
-# output interval [s] (a whole number of steps; default every step)
-OUTPUT_KEYS = ("outputs", "interval")
+# output interval [s] (a whole number of steps; default every step), and `split`, the period [s]
+# between the statistics' low- and wave-frequency parts (default 2·Tp of the sea)
+OUTPUT_KEYS = ("outputs", "interval", "split")
 
 
 def _outputs(p, run):
@@ -86,7 +87,7 @@ def stable_defaults(run_cfg, bodies, couplings, sea, ramp_default=False, joints=
     run_cfg["chosen"] = []
     # what a failed run's advice needs (cosim.master.advice): the waves' ramp and peak period
     run_cfg["waves"] = None if sea is None else {
-        "ramp": sea.ramp, "period": sea.period if sea.spectrum == "regular" else sea.tp}
+        "ramp": sea.ramp, "period": sea.period if sea.spectrum == "regular" else sea.tp, "spectrum": sea.spectrum}
     run_cfg["restoring_omega"] = None
     if sea is not None and ramp_default:
         run_cfg["chosen"].append(f"wave ramp {sea.ramp:g} s (3 peak periods)")
@@ -145,6 +146,7 @@ def read_run(p, run):
         "set": sorted(k for k in run if k != "preset" and k not in OUTPUT_KEYS),   # knobs the scene sets itself
         "outputs": _outputs(p, run),
         "interval": p.number(run, "interval", "run.interval", positive=True) if "interval" in run else None,
+        "split": p.number(run, "split", "run.split", positive=True) if "split" in run else None,
     }
     run_cfg["ecco"] = _ecco(p, run, base, run_cfg["step"] if run_cfg["algorithm"] == "ecco" else None)
     if run_cfg["algorithm"] not in (None, "ecco") and None not in (run_cfg["step"], run_cfg["stop"]):
